@@ -1,0 +1,22 @@
+
+# Consider dependencies only in project.
+set(CMAKE_DEPENDS_IN_PROJECT_ONLY OFF)
+
+# The set of languages for which implicit dependencies are needed:
+set(CMAKE_DEPENDS_LANGUAGES
+  )
+
+# The set of dependency files which are needed:
+set(CMAKE_DEPENDS_DEPENDENCY_FILES
+  "/work/main/cli/main.cpp" "CMakeFiles/cairn_cli.dir/cli/main.cpp.o" "gcc" "CMakeFiles/cairn_cli.dir/cli/main.cpp.o.d"
+  "/work/main/cli/run_command.cpp" "CMakeFiles/cairn_cli.dir/cli/run_command.cpp.o" "gcc" "CMakeFiles/cairn_cli.dir/cli/run_command.cpp.o.d"
+  )
+
+# Targets to which this target links.
+set(CMAKE_TARGET_LINKED_INFO_FILES
+  "/work/main/build/CMakeFiles/cairn_validation.dir/DependInfo.cmake"
+  "/work/main/build/CMakeFiles/cairn.dir/DependInfo.cmake"
+  )
+
+# Fortran module output directory.
+set(CMAKE_Fortran_TARGET_MODULE_DIR "")

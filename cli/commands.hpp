@@ -1,0 +1,12 @@
+// The `cairn` subcommands. Each returns the process exit status:
+//   0 success, 1 a check failed (validate), 2 bad input (nothing written),
+//   3 a non-finite state was caught during the run.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace cairn::cli {
+
+void addRunCommand(CLI::App& app, int& status);
+
+}  // namespace cairn::cli

@@ -1,0 +1,19 @@
+// Convex hulls from point clouds (qhull, Debian's libqhull-dev).
+#pragma once
+
+#include "collision/shape.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cairn {
+
+// Builds the hull of `points`. Throws InputError(object, field, ...) when a
+// point is not finite or the points are degenerate (fewer than 4, or all
+// coplanar): a hull must enclose volume.
+std::shared_ptr<const ConvexHullData> buildConvexHull(const std::vector<Vec3>& points,
+                                                      const std::string& object = "",
+                                                      const std::string& field = "points");
+
+}  // namespace cairn

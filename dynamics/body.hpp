@@ -1,0 +1,104 @@
+// The rigid body state of section 12.6.1 (Listing 12.2).
+//
+// Primary state: center-of-mass position, orientation quaternion, linear and
+// angular velocity (world frame). Constant properties: mass and body-space
+// inertia tensor and their inverses. Derived each step: the rotation matrix
+// and the world-space inverse inertia R J^-1 R^T. Working variables: force
+// and torque accumulators, cleared after every step.
+//
+// Static bodies have zero inverse mass and never move. Kinematic bodies also
+// have zero inverse mass but move with their scripted velocity, which
+// contacts and joints see.
+#pragma once
+
+#include "collision/shape.hpp"
+#include "dynamics/math.hpp"
+
+#include <string>
+#include <vector>
+
+namespace cairn {
+
+enum class BodyType { Static, Kinematic, Dynamic };
+
+const char* bodyTypeName(BodyType t);
+
+// How the gyroscopic torque -w x (J w) enters the velocity update
+// (docs/dynamics.md compares them on a tumbling box).
+enum class Gyroscopic {
+  Off,             // ignored: w' = J^-1 tau only
+  Explicit,        // forward Euler on the world-frame term (gains energy)
+  ImplicitEuler,   // backward Euler in the body frame, one Newton step
+                   // (Bullet's default: stable but dissipative)
+  ImplicitMidpoint // midpoint rule on the body-frame Euler equations with
+                   // the orientation advanced at the midpoint velocity:
+                   // conserves kinetic energy and L of a free body (default)
+};
+
+// How the orientation quaternion follows the angular velocity.
+enum class OrientationIntegrator {
+  ExponentialMap,  // q <- exp(h w) q, exact for constant w (default)
+  Derivative       // q <- normalize(q + h/2 w q), section 12.6.4's first method
+};
+
+struct Body {
+  std::string name;
+  BodyType type = BodyType::Dynamic;
+
+  // Primary state.
+  Vec3 position = Vec3::Zero();  // center of mass, world frame
+  Quat orientation = Quat::Identity();
+  Vec3 linear_velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();  // world frame
+
+  // Constant properties.
+  Real mass = 0;
+  Real inv_mass = 0;
+  Mat3 inertia_body = Mat3::Zero();      // about the center of mass
+  Mat3 inv_inertia_body = Mat3::Zero();
+
+  // Derived.
+  Mat3 rotation = Mat3::Identity();
+  Mat3 inv_inertia_world = Mat3::Zero();
+
+  // Working variables.
+  Vec3 force = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();
+
+  // Material and damping.
+  Real friction = Real(0.5);
+  Real restitution = 0;
+  Real linear_damping = 0;   // 1/s: v *= 1 / (1 + h c)
+  Real angular_damping = 0;
+  bool ccd = false;          // continuous collision for fast bodies
+
+  // Shapes in the body frame: positions relative to the center of mass.
+  std::vector<ShapeDesc> shapes;
+
+  bool isDynamic() const { return type == BodyType::Dynamic; }
+
+  Transform transform() const { return Transform{position, orientation}; }
+
+  // Refresh R and R J^-1 R^T from the orientation.
+  void updateDerived() {
+    rotation = orientation.toRotationMatrix();
+    inv_inertia_world = rotation * inv_inertia_body * rotation.transpose();
+  }
+
+  Vec3 velocityAt(const Vec3& world_point) const {
+    return linear_velocity + angular_velocity.cross(world_point - position);
+  }
+
+  // Angular momentum about the center of mass, world frame: R J R^T w.
+  Vec3 angularMomentum() const {
+    return rotation * (inertia_body * (rotation.transpose() * angular_velocity));
+  }
+
+  Real kineticEnergy() const {
+    if (!isDynamic()) return 0;
+    return Real(0.5) * mass * linear_velocity.squaredNorm() +
+           Real(0.5) * angular_velocity.dot(angularMomentum());
+  }
+};
+
+}  // namespace cairn

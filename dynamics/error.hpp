@@ -1,0 +1,41 @@
+// The one exception type for bad input. It names the object ("body 'crate'",
+// "joint 'hinge1'", "solver") and the field ("mass", "shapes[1].radius"), so
+// the command line can print one line that says exactly what to fix.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace cairn {
+
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string object, std::string field, const std::string& message)
+      : std::runtime_error(compose(object, field, message)),
+        object_(std::move(object)),
+        field_(std::move(field)),
+        message_(message) {}
+
+  const std::string& object() const { return object_; }
+  const std::string& field() const { return field_; }
+  const std::string& message() const { return message_; }
+
+  static std::string compose(const std::string& object, const std::string& field,
+                             const std::string& message) {
+    std::string s;
+    if (!object.empty()) s += object;
+    if (!field.empty()) s += (s.empty() ? "field '" : ": field '") + field + "'";
+    return s.empty() ? message : s + ": " + message;
+  }
+
+ private:
+  std::string object_, field_, message_;
+};
+
+// A step that produced a non-finite state: names the body and the stage.
+class NumericalError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace cairn

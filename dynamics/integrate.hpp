@@ -1,0 +1,28 @@
+// Semi-implicit Euler (section 12.6.3): velocities first, from forces and
+// gravity, then positions from the new velocities. Orientation follows the
+// angular velocity by the exponential map or by the quaternion derivative
+// q' = 1/2 w q (section 12.6.4).
+#pragma once
+
+#include "dynamics/body.hpp"
+
+namespace cairn {
+
+// v* = v + h (g + f / m), w* = w + h J_w^-1 tau, then the gyroscopic term
+// by `gyro`, then damping v *= 1 / (1 + h c). Only dynamic bodies change.
+// Returns the world-frame angular velocity offset that the position stage
+// must add for the orientation to advance at the midpoint velocity
+// (non-zero only for Gyroscopic::ImplicitMidpoint; see integrate.cpp).
+Vec3 integrateVelocity(Body& b, const Vec3& gravity, Real h, Gyroscopic gyro);
+
+// x += h v; q advanced by h (w + orientation_offset); derived data refreshed.
+// Static bodies do not move; kinematic and dynamic bodies do.
+void integratePosition(Body& b, Real h, OrientationIntegrator method,
+                       const Vec3& orientation_offset = Vec3::Zero());
+
+// Body-frame angular velocity after one torque-free gyroscopic step of each
+// kind, exposed for tests and docs. `w` and the result are body-frame.
+Vec3 gyroscopicImplicitEuler(const Mat3& inertia, const Vec3& w, Real h);
+Vec3 gyroscopicImplicitMidpoint(const Mat3& inertia, const Vec3& w, Real h);
+
+}  // namespace cairn

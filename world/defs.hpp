@@ -1,0 +1,113 @@
+// Definitions: plain structs a user fills and hands to World::create*, as in
+// Box2D's b2BodyDef. Every field has a usable default. The World validates a
+// definition completely before it changes anything.
+#pragma once
+
+#include "collision/shape.hpp"
+#include "dynamics/body.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cairn {
+
+// Small integer handles into the World's arrays (never pointers).
+struct BodyId {
+  std::int32_t index = -1;
+  bool isWorld() const { return index < 0; }
+  friend bool operator==(BodyId a, BodyId b) { return a.index == b.index; }
+};
+inline constexpr BodyId kWorldBody{-1};
+
+struct JointId {
+  std::int32_t index = -1;
+  friend bool operator==(JointId a, JointId b) { return a.index == b.index; }
+};
+
+struct BodyDef {
+  std::string name;
+  BodyType type = BodyType::Dynamic;
+  // Exactly one of mass and density for a dynamic body with shapes; a
+  // dynamic body without volume (no shapes) needs mass and inertia.
+  std::optional<Real> mass;
+  std::optional<Real> density;
+  std::optional<Mat3> inertia;  // body frame, about the center of mass
+  Vec3 position = Vec3::Zero();  // of the body frame origin (shapes are offset from it)
+  Quat orientation = Quat::Identity();
+  Vec3 linear_velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();  // world frame, rad/s
+  std::vector<ShapeDesc> shapes;
+  Real friction = Real(0.5);
+  Real restitution = 0;
+  Real linear_damping = 0;
+  Real angular_damping = 0;
+  bool ccd = false;
+  // Collision filtering: two shapes collide when
+  // (a.group & b.mask) != 0 and (b.group & a.mask) != 0.
+  std::uint32_t collision_group = 1;
+  std::uint32_t collision_mask = 0xffffffffu;
+};
+
+struct SpringDef {
+  std::string name;
+  BodyId body_a = kWorldBody, body_b = kWorldBody;
+  Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();  // world points at creation
+  std::optional<Real> rest_length;  // default: the anchors' distance at creation
+  Real stiffness = 0;  // N/m
+  Real damping = 0;    // N s/m
+};
+
+// Softness of a constraint in one of three spellings (docs/constraints.md):
+// raw ERP/CFM, a spring (stiffness N/m or N m/rad, damping N s/m), or a
+// frequency (Hz) and damping ratio. Unset fields fall back to the solver's
+// global ERP and CFM.
+struct Softness {
+  std::optional<Real> erp, cfm;
+  std::optional<Real> stiffness, damping;
+  std::optional<Real> frequency, damping_ratio;
+  bool isSet() const { return erp || cfm || stiffness || damping || frequency || damping_ratio; }
+};
+
+struct LimitDef {
+  bool enabled = false;
+  Real lower = 0, upper = 0;  // rad for angular limits, m for linear ones
+  Real restitution = 0;
+  Softness softness;
+};
+
+struct MotorDef {
+  bool enabled = false;
+  Real target_velocity = 0;  // rad/s or m/s
+  Real max_force = 0;        // N or N m; the row's bounds are +- max_force h
+};
+
+enum class JointType { Ball, Hinge, Slider, Fixed, Universal, ConeTwist, Distance, AngularMotor };
+
+const char* jointTypeName(JointType t);
+
+struct JointDef {
+  std::string name;
+  JointType type = JointType::Ball;
+  BodyId body_a = kWorldBody, body_b = kWorldBody;
+  Vec3 anchor = Vec3::Zero();        // world frame at creation
+  Vec3 axis = Vec3::UnitZ();         // hinge/slider axis, cone-twist twist axis, universal axis on a
+  Vec3 axis2 = Vec3::UnitX();        // universal: axis on b
+  Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();  // distance joint
+  std::optional<Real> length;        // distance joint, default: the anchors' distance
+  LimitDef limit;                    // hinge angle, slider distance, cone-twist twist
+  Real swing_span1 = kPi, swing_span2 = kPi;  // cone-twist cone half-angles (rad)
+  MotorDef motor;                    // hinge, slider
+  // Angular motor: target angular velocity of b relative to a on up to three
+  // world axes, each with its own maximum torque.
+  std::vector<Vec3> motor_axes;
+  std::vector<Real> motor_targets;
+  std::vector<Real> motor_max_torques;
+  Softness softness;
+  Real break_force = kInf;  // N; the joint is removed when its force exceeds this
+  Real break_torque = kInf;
+  bool collide_connected = false;
+};
+
+}  // namespace cairn

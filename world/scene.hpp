@@ -1,0 +1,38 @@
+// A scene in memory: what a scene file holds, independent of any engine.
+// The same SceneDesc builds a cairn World (world/world.hpp) or, for
+// validation, a Bullet world (validation/bullet_oracle.hpp).
+#pragma once
+
+#include "world/defs.hpp"
+#include "world/settings.hpp"
+
+#include <string>
+#include <vector>
+
+namespace cairn {
+
+class World;
+
+struct SceneDesc {
+  std::string path;  // where it was read from, for messages ("" if built in code)
+  Vec3 gravity = Vec3(0, Real(-9.81), 0);
+  Real dt = Real(1) / 60;
+  int steps = 600;
+  SolverSettings solver;
+  std::vector<BodyDef> bodies;
+  std::vector<SpringDef> springs;
+  std::vector<JointDef> joints;
+  std::string validation_json;  // the raw "validation" block, read by validation/
+
+  int bodyIndex(const std::string& name) const {
+    for (size_t i = 0; i < bodies.size(); ++i)
+      if (bodies[i].name == name) return static_cast<int>(i);
+    return -1;
+  }
+};
+
+// Build a World from a scene. Validates everything first: on bad input it
+// throws InputError and builds nothing.
+World buildWorld(const SceneDesc& scene);
+
+}  // namespace cairn

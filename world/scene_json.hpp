@@ -1,0 +1,22 @@
+// The JSON scene format (docs/scene-format.md) to and from SceneDesc.
+#pragma once
+
+#include "world/scene.hpp"
+
+#include <string>
+
+namespace cairn {
+
+// Reads and validates a scene file. Throws InputError whose message starts
+// with the file name and names the object and field at fault.
+SceneDesc loadScene(const std::string& path);
+
+// Parses scene JSON text; `path` is used for messages and to resolve
+// relative paths (meshes).
+SceneDesc parseScene(const std::string& text, const std::string& path);
+
+// Checks cross-references and values of a whole scene (the same checks the
+// World does on creation) without building anything.
+void validateScene(const SceneDesc& scene);
+
+}  // namespace cairn

@@ -1,0 +1,47 @@
+// Everything a user tunes about a step, with Bullet-like defaults where a
+// default matters when comparing (../shared/SCENARIOS.md). Scene files set
+// these under "solver" (docs/scene-format.md).
+#pragma once
+
+#include "dynamics/body.hpp"
+#include "dynamics/math.hpp"
+
+#include <cstdint>
+
+namespace cairn {
+
+enum class SolverMethod { PGS, Direct, LCP };
+
+const char* solverMethodName(SolverMethod m);
+
+struct SolverSettings {
+  SolverMethod method = SolverMethod::PGS;
+  int iterations = 10;          // PGS sweeps per step (Bullet: 10)
+  Real tolerance = 0;           // early exit when the residual falls below this; 0 = never
+  Real sor = 1;                 // successive over-relaxation factor, (0, 2)
+  bool warm_start = true;       // start from last step's impulses
+  Real warm_start_factor = 1;   // scale applied to the carried impulses
+  bool randomize_order = false; // shuffle rows each sweep (seeded, reproducible)
+  std::uint64_t seed = 1;
+  int substeps = 1;             // sub-steps per step
+
+  // ODE-style softness for joints (and contacts without split impulse).
+  Real erp = Real(0.2);
+  Real cfm = 0;
+
+  // Contacts (issue: collision).
+  Real contact_erp = Real(0.2);
+  Real slop = Real(0.005);               // allowed penetration, m
+  Real restitution_threshold = Real(0.2); // m/s: slower approach does not bounce
+  bool split_impulse = true;
+  Real max_correction_velocity = Real(10);  // m/s, clamp on ERP push-out
+
+  // Safety nets for the extremes.
+  Real max_angular_velocity = kInf;  // rad/s, per body
+
+  // Integrators (section 12.6.3 and 12.6.4).
+  Gyroscopic gyroscopic = Gyroscopic::ImplicitMidpoint;
+  OrientationIntegrator orientation = OrientationIntegrator::ExponentialMap;
+};
+
+}  // namespace cairn

@@ -1,0 +1,111 @@
+// The World: owns bodies, shapes, springs, joints and settings, hands out
+// integer handles, and runs the step pipeline of ../shared/ARCHITECTURE.md
+// (world/world_step.cpp reads top to bottom as that pipeline).
+#pragma once
+
+#include "dynamics/body.hpp"
+#include "world/defs.hpp"
+#include "world/settings.hpp"
+
+#include <string>
+#include <vector>
+
+namespace cairn {
+
+struct Spring {
+  SpringDef def;
+  Vec3 local_a, local_b;  // anchors in the body frames (world points for the world)
+  Real rest_length;
+};
+
+// What a step reports about itself (the solver's quality, MuJoCo-style).
+struct StepStats {
+  int iterations = 0;
+  Real residual = 0;
+  int rows = 0;
+  double wall_seconds = 0;
+};
+
+// A non-finite value caught by the guard: which body and which stage.
+struct NumericalEvent {
+  int step = 0;
+  BodyId body;
+  std::string body_name;
+  std::string stage;
+};
+
+class World {
+ public:
+  World() = default;
+  explicit World(const Vec3& gravity) : gravity_(gravity) {}
+
+  // --- Creation: validates the whole definition first, then creates. On bad
+  // input throws InputError and leaves the world unchanged.
+  BodyId createBody(const BodyDef& def);
+  int createSpring(const SpringDef& def);
+
+  // --- Access
+  int bodyCount() const { return static_cast<int>(bodies_.size()); }
+  const Body& body(BodyId id) const { return bodies_.at(static_cast<size_t>(id.index)); }
+  Body& body(BodyId id) { return bodies_.at(static_cast<size_t>(id.index)); }
+  const std::vector<Body>& bodies() const { return bodies_; }
+  BodyId findBody(const std::string& name) const;
+  const std::vector<Spring>& springs() const { return springs_; }
+
+  // --- Forces (accumulate until the end of the next step) and impulses.
+  void applyForce(BodyId id, const Vec3& force, const Vec3& world_point);
+  void applyCentralForce(BodyId id, const Vec3& force);
+  void applyTorque(BodyId id, const Vec3& torque);
+  void applyImpulse(BodyId id, const Vec3& impulse, const Vec3& world_point);
+  // Scripted motion of a kinematic body.
+  void setKinematicVelocity(BodyId id, const Vec3& linear, const Vec3& angular);
+
+  // --- Settings
+  const Vec3& gravity() const { return gravity_; }
+  void setGravity(const Vec3& g);
+  SolverSettings& settings() { return settings_; }
+  const SolverSettings& settings() const { return settings_; }
+  // Validates and sets (throws InputError naming "solver" and the field).
+  void setSettings(const SolverSettings& s);
+
+  // --- Stepping
+  void step(Real h);
+  int stepCount() const { return step_count_; }
+  Real time() const { return time_; }
+  const StepStats& lastStepStats() const { return stats_; }
+  // Non-finite states caught and rolled back (never silently passed on).
+  const std::vector<NumericalEvent>& numericalEvents() const { return numerical_events_; }
+
+  // --- Energy bookkeeping for tests and metrics.
+  Real kineticEnergy() const;
+  Real potentialEnergy() const;  // gravity (relative to y = 0 along -g) + springs
+  Vec3 linearMomentum() const;
+
+ private:
+  void applyExternalForces();
+  void integrateVelocities(Real h);
+  void integratePositions(Real h);
+  void clearAccumulators();
+  bool guardFinite(const char* stage);
+  void saveStepStart();
+  void restoreBody(size_t i);
+
+  Vec3 gravity_ = Vec3(0, Real(-9.81), 0);
+  SolverSettings settings_;
+  std::vector<Body> bodies_;
+  std::vector<Spring> springs_;
+
+  // Per-step working arrays (sized once, reused: no allocation per step).
+  std::vector<Vec3> orientation_offset_;
+  struct SavedState { Vec3 x; Quat q; Vec3 v; Vec3 w; };
+  std::vector<SavedState> step_start_;
+
+  int step_count_ = 0;
+  Real time_ = 0;
+  StepStats stats_;
+  std::vector<NumericalEvent> numerical_events_;
+};
+
+void validateSettings(const SolverSettings& s);
+
+}  // namespace cairn

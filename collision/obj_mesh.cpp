@@ -1,9 +1,143 @@
-// TEMPORARY until the collision module lands (being written now).
+// Wavefront OBJ reader for static triangle meshes.
+//
+// The subset read: `v x y z [w]` vertices and `f` faces whose corners are
+// `i`, `i/t`, `i//n` or `i/t/n` (only the position index i is used).
+// Indices are 1-based; a negative index counts back from the last vertex
+// defined so far (-1 is the previous vertex), as the format specifies. A face
+// with k > 3 corners is fanned into k - 2 triangles (0, j, j + 1), which is
+// exact for the convex planar polygons exporters write.
+//
+// Records that carry no geometry for collision (vn, vt, vp, o, g, s, usemtl,
+// mtllib, l, p, comments) are skipped. Anything else is an error: a typo in
+// level geometry is better reported than silently dropped.
 #include "collision/obj_mesh.hpp"
+
 #include "dynamics/error.hpp"
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
 namespace cairn {
+namespace {
+
+struct Reader {
+  const std::string& path;
+  const std::string& object;
+  const std::string& field;
+  int line = 0;
+
+  [[noreturn]] void fail(const std::string& reason) const {
+    throw InputError(object, field, path + ":" + std::to_string(line) + ": " + reason);
+  }
+};
+
+bool parseReal(const std::string& tok, Real& out) {
+  if (tok.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  out = std::strtod(tok.c_str(), &end);
+  return end == tok.c_str() + tok.size();
+}
+
+bool parseInt(const std::string& tok, long& out) {
+  if (tok.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  out = std::strtol(tok.c_str(), &end, 10);
+  return errno == 0 && end == tok.c_str() + tok.size();
+}
+
+bool ignoredRecord(const std::string& k) {
+  static const char* kIgnored[] = {"vn", "vt", "vp", "o", "g", "s", "usemtl", "mtllib", "l", "p"};
+  for (const char* s : kIgnored)
+    if (k == s) return true;
+  return false;
+}
+
+}  // namespace
+
 std::shared_ptr<const TriangleMeshData> loadObjMesh(const std::string& path, const std::string& object,
                                                     const std::string& field) {
-  throw InputError(object, field, "meshes are not loaded yet: " + path);
+  std::ifstream in(path);
+  if (!in) throw InputError(object, field, path + ":0: cannot open file (" + std::strerror(errno) + ")");
+
+  auto mesh = std::make_shared<TriangleMeshData>();
+  Reader r{path, object, field};
+  // Positive indices are resolved after the whole file is read (some
+  // exporters reference vertices written later); keep where each came from.
+  struct Pending {
+    long index[3];
+    int line;
+  };
+  std::vector<Pending> pending;
+  std::string text;
+  std::vector<long> corners;
+  while (std::getline(in, text)) {
+    ++r.line;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    const size_t hash = text.find('#');
+    if (hash != std::string::npos) text.resize(hash);
+    std::istringstream ls(text);
+    std::string key;
+    if (!(ls >> key)) continue;  // blank or comment-only line
+    if (key == "v") {
+      Vec3 v;
+      std::string tok;
+      for (int k = 0; k < 3; ++k) {
+        if (!(ls >> tok) || !parseReal(tok, v[k])) r.fail("malformed vertex: expected 'v x y z'");
+      }
+      if (ls >> tok) {
+        Real w;
+        if (!parseReal(tok, w) || (ls >> tok)) r.fail("malformed vertex: expected 'v x y z [w]'");
+      }
+      if (!v.allFinite()) r.fail("vertex is not finite");
+      mesh->vertices.push_back(v);
+    } else if (key == "f") {
+      corners.clear();
+      std::string tok;
+      while (ls >> tok) {
+        // The position index is everything before the first '/'.
+        const std::string head = tok.substr(0, tok.find('/'));
+        long idx = 0;
+        if (!parseInt(head, idx)) r.fail("malformed face corner '" + tok + "'");
+        if (idx == 0) r.fail("face index 0 is invalid (OBJ indices start at 1)");
+        if (idx < 0) {
+          const long resolved = static_cast<long>(mesh->vertices.size()) + idx;
+          if (resolved < 0)
+            r.fail("face index " + std::to_string(idx) + " out of range (" +
+                   std::to_string(mesh->vertices.size()) + " vertices so far)");
+          idx = resolved;
+        } else {
+          idx -= 1;
+        }
+        corners.push_back(idx);
+      }
+      if (corners.size() < 3) r.fail("face needs at least 3 vertices");
+      for (size_t j = 1; j + 1 < corners.size(); ++j)
+        pending.push_back({{corners[0], corners[j], corners[j + 1]}, r.line});
+    } else if (!ignoredRecord(key)) {
+      r.fail("unknown record '" + key + "'");
+    }
+  }
+  if (in.bad()) r.fail("read error");
+
+  const long nv = static_cast<long>(mesh->vertices.size());
+  for (const Pending& p : pending) {
+    for (long idx : p.index) {
+      if (idx >= nv) {
+        r.line = p.line;
+        r.fail("face index " + std::to_string(idx + 1) + " out of range (" + std::to_string(nv) + " vertices)");
+      }
+    }
+    // A triangle that repeats a vertex has no area and no normal: skip it.
+    if (p.index[0] == p.index[1] || p.index[1] == p.index[2] || p.index[0] == p.index[2]) continue;
+    mesh->triangles.push_back({static_cast<int>(p.index[0]), static_cast<int>(p.index[1]), static_cast<int>(p.index[2])});
+  }
+  if (mesh->triangles.empty()) throw InputError(object, field, path + ":" + std::to_string(r.line) + ": no triangles (no 'f' records with 3 distinct vertices)");
+  return mesh;
 }
+
 }  // namespace cairn

@@ -16,6 +16,7 @@ World buildWorld(const SceneDesc& scene) {
   world.setSettings(scene.solver);
   for (const auto& b : scene.bodies) world.createBody(b);
   for (const auto& s : scene.springs) world.createSpring(s);
+  for (const auto& j : scene.joints) world.createJoint(j);
   return world;
 }
 

@@ -13,6 +13,7 @@
 #include "dynamics/error.hpp"
 #include "dynamics/forces.hpp"
 #include "dynamics/integrate.hpp"
+#include "solver/pgs.hpp"
 #include "world/world.hpp"
 
 #include <chrono>
@@ -25,18 +26,110 @@ void World::step(Real h) {
     throw InputError("world", "dt", "time step must be positive and finite (got " + std::to_string(h) + ")");
   const auto t0 = std::chrono::steady_clock::now();
   saveStepStart();
+  break_events_.clear();
+  stats_ = StepStats{};
 
+  // Substeps repeat stages 2 to 6 with h / n, the forces held for the step
+  // (Box2D v3's soft step: accuracy bought with substeps, not iterations).
+  const int n = settings_.substeps;
+  const Real hs = h / n;
   applyExternalForces();                                  // 1
-  integrateVelocities(h);                                 // 2
-  guardFinite("velocity integration");
-  // 3-5: collision, constraint rows and the solver arrive with their issues.
-  integratePositions(h);                                  // 6
-  guardFinite("position integration");
+  // 3: collision detection (the collision module) runs once per step here.
+  for (int sub = 0; sub < n; ++sub) {
+    integrateVelocities(hs);                              // 2
+    if (!guardFinite("velocity integration")) break;
+    buildRows(hs);                                        // 4
+    solveRows();                                          // 5
+    if (!guardFinite("constraint solve")) break;
+    integratePositions(hs);                               // 6
+    if (!guardFinite("position integration")) break;
+    storeImpulses(hs);
+  }
   clearAccumulators();                                    // 7
 
   ++step_count_;
   time_ += h;
   stats_.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Stage 4: every active joint writes its rows (constraints/*_joint.cpp).
+void World::buildRows(Real h) {
+  rows_.clear();
+  const JointRowSettings jrs{settings_.restitution_threshold};
+  for (size_t i = 0; i < joints_.size(); ++i) {
+    const Joint& j = joints_[i];
+    if (j.broken) continue;
+    RowContext ctx;
+    ctx.h = h;
+    ctx.erp = settings_.erp;
+    ctx.cfm = settings_.cfm;
+    ctx.joint_softness = &j.def.softness;
+    ctx.owner = static_cast<std::int32_t>(i);
+    ctx.rows = &rows_;
+    ctx.warm = settings_.warm_start ? &j.warm : nullptr;
+    ctx.warm_factor = settings_.warm_start_factor;
+    buildJointRows(j, view(j.def.body_a), view(j.def.body_b), ctx, jrs);
+  }
+  stats_.rows = static_cast<int>(rows_.size());
+  for (int& k : stats_.rows_by_kind) k = 0;
+  for (const ConstraintRow& r : rows_) ++stats_.rows_by_kind[static_cast<int>(r.kind)];
+}
+
+// Stage 5: v = v* + M^-1 J^T lambda with lambda from the chosen solver.
+void World::solveRows() {
+  if (rows_.empty()) return;
+  solver_bodies_.resize(bodies_.size() + 1);
+  solver_bodies_[0] = SolverBody{};
+  for (size_t i = 0; i < bodies_.size(); ++i)
+    solver_bodies_[i + 1] = SolverBody{bodies_[i].linear_velocity, bodies_[i].angular_velocity};
+  if (!rng_seeded_) {
+    rng_state_ = settings_.seed;
+    rng_seeded_ = true;
+  }
+  applyWarmStart(rows_, solver_bodies_);
+  const PgsSettings ps{settings_.iterations, settings_.tolerance, settings_.sor, settings_.randomize_order,
+                       settings_.seed};
+  const PgsStats st = solvePgs(rows_, solver_bodies_, ps, order_scratch_, rng_state_);
+  stats_.iterations += st.iterations;
+  stats_.residual = pgsResidual(rows_, solver_bodies_);
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    if (!bodies_[i].isDynamic()) continue;
+    bodies_[i].linear_velocity = solver_bodies_[i + 1].v;
+    bodies_[i].angular_velocity = solver_bodies_[i + 1].w;
+  }
+}
+
+// Keeps each row's impulse for warm starting, turns the impulses into the
+// joints' force feedback (lambda / h through J), and breaks joints whose
+// force or torque exceeded their threshold.
+void World::storeImpulses(Real h) {
+  for (Joint& j : joints_) {
+    std::fill(j.warm.begin(), j.warm.end(), Real(0));
+    j.feedback = JointFeedback{};
+  }
+  for (const ConstraintRow& r : rows_) {
+    if (r.owner < 0 || r.kind >= RowKind::ContactNormal) continue;
+    Joint& j = joints_[static_cast<size_t>(r.owner)];
+    j.warm[static_cast<size_t>(r.owner_row)] = r.lambda;
+    const Real f = r.lambda / h;
+    j.feedback.force_a += r.j_lin_a * f;
+    j.feedback.torque_a += r.j_ang_a * f;
+    j.feedback.force_b += r.j_lin_b * f;
+    j.feedback.torque_b += r.j_ang_b * f;
+  }
+  for (size_t i = 0; i < joints_.size(); ++i) {
+    Joint& j = joints_[i];
+    if (j.broken) continue;
+    const Real force = j.feedback.force_b.norm();
+    // Torque about the anchor on b: remove the moment of the force about b's center.
+    const Vec3 anchor_b = j.def.body_b.isWorld() ? j.local_anchor_b : body(j.def.body_b).transform().apply(j.local_anchor_b);
+    const Vec3 arm = anchor_b - (j.def.body_b.isWorld() ? Vec3::Zero() : body(j.def.body_b).position);
+    const Real torque = (j.feedback.torque_b - arm.cross(j.feedback.force_b)).norm();
+    if (force > j.def.break_force || torque > j.def.break_torque) {
+      break_events_.push_back({step_count_, JointId{static_cast<std::int32_t>(i)}, j.def.name, force, torque});
+      removeJoint(JointId{static_cast<std::int32_t>(i)});
+    }
+  }
 }
 
 void World::applyExternalForces() {

@@ -1,0 +1,101 @@
+// A joint in the World: its definition, its frames captured at creation
+// (anchors and axes stored in each body's frame, so they move with the
+// bodies), the impulses carried between steps for warm starting, and the
+// force feedback of the last step.
+//
+// Each joint type lives in its own file (constraints/<type>_joint.cpp) and
+// writes its rows through the parts of constraints/parts.hpp. Row slots are
+// fixed per type so warm starting is keyed by (joint, slot):
+//
+//   type          rows (slots)
+//   ball          point 0-2
+//   hinge         point 0-2, two angular 3-4, limit 5, motor 6
+//   slider        orientation 0-2, two linear 3-4, limit 5, motor 6
+//   fixed         point 0-2, orientation 3-5
+//   universal     point 0-2, one angular 3
+//   cone_twist    point 0-2, swing 3, twist 4
+//   distance      one linear 0
+//   angular_motor up to three angular 0-2
+#pragma once
+
+#include "constraints/parts.hpp"
+#include "world/defs.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace cairn {
+
+inline constexpr int kMaxJointRows = 7;
+
+struct JointFeedback {
+  Vec3 force_a = Vec3::Zero(), torque_a = Vec3::Zero();  // on body a, torque about its center of mass
+  Vec3 force_b = Vec3::Zero(), torque_b = Vec3::Zero();  // on body b
+};
+
+struct Joint {
+  JointDef def;
+  bool broken = false;
+
+  // Frames in body coordinates (relative to the center of mass); for the
+  // world they are world coordinates.
+  Vec3 local_anchor_a = Vec3::Zero(), local_anchor_b = Vec3::Zero();
+  Vec3 local_axis_a = Vec3::UnitZ(), local_axis_b = Vec3::UnitZ();
+  Vec3 local_ref_a = Vec3::UnitX(), local_ref_b = Vec3::UnitX();  // perpendicular to the axis
+  Vec3 local_axis2_b = Vec3::UnitX();                             // universal joint
+  Quat rel_orientation0 = Quat::Identity();                       // q_a^-1 q_b at creation
+  Real length = 0;                                                // distance joint
+  std::vector<Vec3> local_motor_axes;                             // angular motor, in a's frame
+
+  // Warm start: last step's impulse per slot (zero for a slot that had no row).
+  std::vector<Real> warm = std::vector<Real>(kMaxJointRows, 0);
+  JointFeedback feedback;
+};
+
+// Fills the joint's body-frame data from its world-frame definition and the
+// bodies' poses at creation. `a` or `b` is the world's BodyView when the
+// joint attaches to the world.
+Joint makeJoint(const JointDef& def, const BodyView& a, const BodyView& b);
+
+// Checks a definition (throws InputError naming "joint 'name'" and the field).
+void validateJointDef(const JointDef& def, int body_count);
+
+// Appends the joint's rows for this step.
+struct JointRowSettings {
+  Real restitution_threshold = Real(0.2);
+};
+void buildJointRows(const Joint& j, const BodyView& a, const BodyView& b, RowContext& ctx,
+                    const JointRowSettings& settings);
+
+// Position error of the joint now: the largest anchor separation (m) of its
+// positional rows and the largest angle error (rad) of its angular rows
+// (limits count only when violated).
+struct JointError {
+  Real linear = 0;
+  Real angular = 0;
+};
+JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& b);
+
+// World-frame anchors and axes of a joint at the bodies' current poses.
+inline Vec3 worldPoint(const BodyView& v, const Vec3& local) { return v.x + v.q * local; }
+inline Vec3 worldVector(const BodyView& v, const Vec3& local) { return v.q * local; }
+
+// Per-type row builders (one file each).
+void buildBallRows(const Joint&, const BodyView&, const BodyView&, RowContext&);
+void buildHingeRows(const Joint&, const BodyView&, const BodyView&, RowContext&, const JointRowSettings&);
+void buildSliderRows(const Joint&, const BodyView&, const BodyView&, RowContext&, const JointRowSettings&);
+void buildFixedRows(const Joint&, const BodyView&, const BodyView&, RowContext&);
+void buildUniversalRows(const Joint&, const BodyView&, const BodyView&, RowContext&);
+void buildConeTwistRows(const Joint&, const BodyView&, const BodyView&, RowContext&, const JointRowSettings&);
+void buildDistanceRows(const Joint&, const BodyView&, const BodyView&, RowContext&);
+void buildAngularMotorRows(const Joint&, const BodyView&, const BodyView&, RowContext&);
+
+// Hinge angle of b relative to a about the hinge axis (rad, in (-pi, pi]).
+Real hingeAngle(const Joint& j, const BodyView& a, const BodyView& b);
+// Slider translation of b relative to a along the axis (m).
+Real sliderPosition(const Joint& j, const BodyView& a, const BodyView& b);
+// Cone-twist: swing angle (between the twist axes) and twist angle.
+void coneTwistAngles(const Joint& j, const BodyView& a, const BodyView& b, Real& swing, Real& twist);
+
+}  // namespace cairn

@@ -58,15 +58,18 @@ Vec3 integrateVelocity(Body& b, const Vec3& gravity, Real h, Gyroscopic gyro) {
       break;
     }
     case Gyroscopic::ImplicitMidpoint: {
-      // The midpoint rule advances the orientation with wm, not w1: that is
-      // what keeps the world-frame L = R J w fixed (R1 = R0 exp(h wm) undoes
-      // exactly the rotation applied to the body-frame L above). The
-      // difference wm - w1 is handed to the position stage as an offset, so
-      // constraint impulses still act on the state velocity w1.
+      // The midpoint rule advances the orientation with wm, R1 = R0 exp(h wm),
+      // which undoes exactly the rotation applied to the body-frame L above,
+      // so the world-frame L = R J w stays fixed. w1 is a body-frame velocity
+      // at the end of the step, so its world value is R1 w1, and the
+      // difference between the orientation rate (R0 wm) and the state
+      // velocity is handed to the position stage as an offset; constraint
+      // impulses still act on the state velocity.
       const Vec3 wb0 = b.rotation.transpose() * b.angular_velocity;
       const Vec3 wb1 = gyroscopicImplicitMidpoint(b.inertia_body, wb0, h);
-      b.angular_velocity = b.rotation * wb1;
-      orientation_offset = b.rotation * (Real(0.5) * (wb0 - wb1));
+      const Vec3 wbm = Real(0.5) * (wb0 + wb1);
+      b.angular_velocity = b.rotation * (quatFromRotationVector(h * wbm) * wb1);
+      orientation_offset = b.rotation * wbm - b.angular_velocity;
       break;
     }
   }

@@ -1,0 +1,52 @@
+// World bounds of each shape type (formulas in aabb.hpp).
+#include "collision/aabb.hpp"
+
+#include "collision/support.hpp"
+
+namespace cairn {
+
+Aabb shapeAabb(const ShapeDesc& s, const Transform& t) {
+  const Mat3 r = t.q.toRotationMatrix();
+  switch (s.type) {
+    case ShapeType::Sphere: return Aabb::fromCenterHalf(t.p, Vec3::Constant(s.radius));
+    case ShapeType::Box: return Aabb::fromCenterHalf(t.p, r.cwiseAbs() * s.half_extents);
+    case ShapeType::Capsule:
+      return Aabb::fromCenterHalf(t.p, r.col(1).cwiseAbs() * s.half_height + Vec3::Constant(s.radius));
+    case ShapeType::Cylinder: {
+      const Vec3 a = r.col(1);
+      Vec3 half;
+      for (int i = 0; i < 3; ++i)
+        half[i] = s.half_height * std::abs(a[i]) + s.radius * std::sqrt(std::max(Real(0), 1 - a[i] * a[i]));
+      return Aabb::fromCenterHalf(t.p, half);
+    }
+    case ShapeType::ConvexHull: {
+      Aabb box;
+      if (s.hull)
+        for (const Vec3& v : s.hull->vertices) box.grow(t.apply(v));
+      return box;
+    }
+    case ShapeType::Mesh: {
+      Aabb box;
+      if (s.mesh)
+        for (const Vec3& v : s.mesh->vertices) box.grow(t.apply(v));
+      return box;
+    }
+    case ShapeType::Plane: {
+      // Points with n.x <= d. Only an axis-aligned normal bounds anything.
+      Vec3 n;
+      Real d;
+      worldPlane(s, t, n, d);
+      Aabb box{Vec3::Constant(-kInf), Vec3::Constant(kInf)};
+      for (int i = 0; i < 3; ++i) {
+        if (std::abs(n[i]) == 1) {
+          if (n[i] > 0) box.hi[i] = d;
+          else box.lo[i] = -d;
+        }
+      }
+      return box;
+    }
+  }
+  return Aabb{};
+}
+
+}  // namespace cairn

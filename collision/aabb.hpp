@@ -1,0 +1,66 @@
+// Axis-aligned bounding boxes: the broadphase's unit of overlap, and the
+// world bounds of every shape.
+//
+// Bounds of a shape with rotation R at position p:
+//   box       p +- |R| h                        (|R| = entrywise absolute value)
+//   sphere    p +- r
+//   capsule   p +- (|R e_y| hh + r)
+//   cylinder  per world axis i, with unit axis a = R e_y:
+//             p_i +- (hh |a_i| + r sqrt(1 - a_i^2))
+//             (the disc of radius r perpendicular to a reaches
+//              r sqrt(1 - a_i^2) along world axis i)
+//   hull, mesh  the box of the transformed vertices (exact)
+//   plane     a half-space n.x <= d is unbounded: the box is infinite along
+//             every axis, except that an axis-aligned plane bounds its own
+//             axis on one side. isInfinite() says so, and the broadphase
+//             keeps such shapes out of its tree.
+#pragma once
+
+#include "collision/shape.hpp"
+#include "dynamics/math.hpp"
+
+#include <algorithm>
+
+namespace cairn {
+
+struct Aabb {
+  // Default: the empty box (lo > hi), which grow() and merge() start from.
+  Vec3 lo = Vec3::Constant(kInf);
+  Vec3 hi = Vec3::Constant(-kInf);
+
+  static Aabb fromCenterHalf(const Vec3& c, const Vec3& half) { return Aabb{c - half, c + half}; }
+
+  bool empty() const { return (lo.array() > hi.array()).any(); }
+  bool isInfinite() const { return !lo.allFinite() || !hi.allFinite(); }
+  // Closed intervals: boxes that touch overlap (a resting contact has a gap
+  // of exactly zero and must still be found).
+  bool overlaps(const Aabb& o) const {
+    return lo.x() <= o.hi.x() && o.lo.x() <= hi.x() && lo.y() <= o.hi.y() && o.lo.y() <= hi.y() &&
+           lo.z() <= o.hi.z() && o.lo.z() <= hi.z();
+  }
+  bool contains(const Aabb& o) const { return (lo.array() <= o.lo.array()).all() && (o.hi.array() <= hi.array()).all(); }
+  bool contains(const Vec3& p) const { return (lo.array() <= p.array()).all() && (p.array() <= hi.array()).all(); }
+  void grow(const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  Aabb merged(const Aabb& o) const { return Aabb{lo.cwiseMin(o.lo), hi.cwiseMax(o.hi)}; }
+  Aabb expanded(Real margin) const { return Aabb{lo.array() - margin, hi.array() + margin}; }
+  Vec3 center() const { return Real(0.5) * (lo + hi); }
+  Vec3 extent() const { return hi - lo; }
+  // Surface area, the cost the tree's insertion heuristic minimizes (the
+  // probability that a random ray or box hits a box is proportional to it).
+  Real surfaceArea() const {
+    const Vec3 e = hi - lo;
+    return Real(2) * (e.x() * e.y() + e.y() * e.z() + e.z() * e.x());
+  }
+};
+
+// World bounds of `shape` placed at `t` (t already includes shape.local).
+Aabb shapeAabb(const ShapeDesc& shape, const Transform& t);
+
+inline Aabb triangleAabb(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return Aabb{a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)};
+}
+
+}  // namespace cairn

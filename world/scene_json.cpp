@@ -349,6 +349,19 @@ SolverSettings parseSolver(const json& j) {
   return s;
 }
 
+std::string lineOf(const std::string& text, size_t byte) {
+  size_t line = 1, col = 1;
+  for (size_t i = 0; i < std::min(byte, text.size()); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(col);
+}
+
 }  // namespace
 
 SceneDesc parseScene(const std::string& text, const std::string& path) {
@@ -357,7 +370,15 @@ SceneDesc parseScene(const std::string& text, const std::string& path) {
     try {
       j = json::parse(text);
     } catch (const json::parse_error& e) {
-      throw InputError("", "", std::string("malformed JSON: ") + e.what());
+      throw InputError("", "", "malformed JSON at " + lineOf(text, e.byte == 0 ? 0 : e.byte - 1) + ": " + e.what());
+    } catch (const json::exception& e) {
+      // Number overflow (e.g. 1e999, JSON's only way to spell a non-finite
+      // value): locate the quoted token for the line number.
+      const std::string what = e.what();
+      const auto q1 = what.find('\''), q2 = what.rfind('\'');
+      const auto at = q1 != std::string::npos && q2 > q1 ? text.find(what.substr(q1 + 1, q2 - q1 - 1)) : std::string::npos;
+      throw InputError("", "", "malformed JSON" + (at == std::string::npos ? std::string() : " at " + lineOf(text, at)) +
+                                   ": " + what + " (numbers must be finite)");
     }
     const std::filesystem::path base_dir = std::filesystem::path(path).parent_path();
     Reader r(j, "scene");

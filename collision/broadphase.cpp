@@ -1,0 +1,140 @@
+// Broadphase proxies and incremental pair maintenance (see broadphase.hpp).
+#include "collision/broadphase.hpp"
+
+#include <algorithm>
+
+namespace cairn {
+
+Aabb BroadPhase::fatten(const Aabb& tight, const Vec3& displacement) const {
+  Aabb fat = tight.expanded(margin_);
+  const Vec3 d = displacement_multiplier_ * displacement;
+  // Stretch only toward where the body is heading.
+  fat.lo += d.cwiseMin(Vec3::Zero());
+  fat.hi += d.cwiseMax(Vec3::Zero());
+  return fat;
+}
+
+void BroadPhase::markMoved(int h) {
+  Proxy& p = proxies_[h];
+  if (!p.moved) {
+    p.moved = true;
+    moved_.push_back(h);
+  }
+  if (!p.dirty) {
+    p.dirty = true;
+    dirty_.push_back(h);
+  }
+}
+
+int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacement) {
+  int h;
+  if (free_ >= 0) {
+    h = free_;
+    free_ = proxies_[h].next_free;
+  } else {
+    h = static_cast<int>(proxies_.size());
+    proxies_.emplace_back();
+  }
+  Proxy& p = proxies_[h];
+  // A reused handle may still own stale pairs and a place in moved_.
+  const bool dirty = p.dirty, moved = p.moved;
+  p = Proxy{};
+  p.dirty = dirty;
+  p.moved = moved;
+  p.alive = true;
+  p.user = user;
+  if (tight.isInfinite()) {
+    p.fat = tight;
+    infinite_.insert(std::lower_bound(infinite_.begin(), infinite_.end(), h), h);
+  } else {
+    p.fat = fatten(tight, displacement);
+    p.leaf = tree_.insert(p.fat, h);
+  }
+  ++live_;
+  markMoved(h);
+  return h;
+}
+
+void BroadPhase::destroyProxy(int h) {
+  Proxy& p = proxies_[h];
+  if (!p.alive) return;
+  if (p.leaf >= 0) tree_.remove(p.leaf);
+  else infinite_.erase(std::lower_bound(infinite_.begin(), infinite_.end(), h));
+  if (!p.dirty) {
+    p.dirty = true;
+    dirty_.push_back(h);
+  }
+  p.alive = false;
+  p.leaf = -1;
+  p.next_free = free_;
+  free_ = h;
+  --live_;
+}
+
+bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
+  Proxy& p = proxies_[h];
+  if (p.leaf < 0) return false;  // infinite proxies pair with everything already
+  const Aabb want = fatten(tight, displacement);
+  bool reinsert = !p.fat.contains(tight);
+  if (!reinsert) {
+    // A fat box far larger than wanted (the body slowed down) costs false
+    // pairs; shrink it once it overhangs by more than four margins.
+    const Real slack = 4 * margin_;
+    reinsert = ((p.fat.hi - want.hi).array() > slack).any() || ((want.lo - p.fat.lo).array() > slack).any();
+  }
+  if (!reinsert) return false;
+  p.fat = want;
+  tree_.update(p.leaf, want);
+  markMoved(h);
+  return true;
+}
+
+void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
+  // 1. Pairs found by querying each moved proxy. A pair of two moved
+  //    proxies is found twice; keep it from the lower handle's query.
+  fresh_.clear();
+  for (int m : moved_) {
+    const Proxy& pm = proxies_[m];
+    if (!pm.alive) continue;
+    auto add = [&](int o) {
+      if (o == m) return;
+      const Proxy& po = proxies_[o];
+      if (po.moved && o < m) return;
+      fresh_.emplace_back(std::min(m, o), std::max(m, o));
+    };
+    if (pm.leaf < 0) {
+      // Infinite: tested against every finite proxy (an axis-aligned
+      // plane's box still rules out what lies wholly above it).
+      for (int o = 0; o < static_cast<int>(proxies_.size()); ++o) {
+        if (!proxies_[o].alive || proxies_[o].leaf < 0) continue;
+        ++overlap_tests_;
+        if (pm.fat.overlaps(proxies_[o].fat)) add(o);
+      }
+    } else {
+      tree_.query(pm.fat, [&](int leaf) { add(tree_.user(leaf)); return true; }, &overlap_tests_);
+      for (int i : infinite_) {
+        ++overlap_tests_;
+        if (pm.fat.overlaps(proxies_[i].fat)) add(i);
+      }
+    }
+  }
+  // 2. Drop the stale pairs of proxies that moved or died, add the fresh.
+  if (!dirty_.empty()) {
+    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                                [&](const std::pair<int, int>& pr) {
+                                  return proxies_[pr.first].dirty || proxies_[pr.second].dirty;
+                                }),
+                 pairs_.end());
+  }
+  pairs_.insert(pairs_.end(), fresh_.begin(), fresh_.end());
+  std::sort(pairs_.begin(), pairs_.end());
+  pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+
+  for (int h : moved_) proxies_[h].moved = false;
+  for (int h : dirty_) proxies_[h].dirty = false;
+  moved_.clear();
+  dirty_.clear();
+  out.assign(pairs_.begin(), pairs_.end());
+}
+
+}  // namespace cairn

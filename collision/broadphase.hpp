@@ -1,0 +1,101 @@
+// Broadphase: which shapes might touch, from their bounding boxes.
+//
+// Each proxy stores a fat box: its tight box grown by a margin on every side
+// and stretched along the displacement predicted for the next step
+//   fat = expand(tight, margin) u (expand(tight, margin) + k * displacement)
+// (k = displacement_multiplier, e.g. 2 * v * dt). A moving proxy is
+// re-inserted into the tree only when its tight box leaves the fat box (or
+// the fat box has grown far larger than needed), so a slow body costs
+// nothing most steps.
+//
+// Pairs are pairs of fat boxes that overlap. They are kept between updates:
+// a pair can only change when one of its proxies got a new fat box, so
+// updatePairs() re-queries just the proxies that moved (O(m log n) box tests
+// for m moved proxies) and merges the result into the sorted pair list.
+//
+// Infinite shapes (planes: an unbounded box) never enter the tree; they sit
+// in a list and are tested against every finite proxy (a tilted plane's box
+// is all of space and pairs with everything; an axis-aligned one still
+// excludes what lies wholly on its outer side). Two infinite proxies never
+// pair (static planes cannot collide).
+//
+// Proxies are addressed by int handles (reused after destroyProxy) and carry
+// a user int, e.g. the shape index.
+#pragma once
+
+#include "collision/aabb.hpp"
+#include "collision/dynamic_tree.hpp"
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace cairn {
+
+class BroadPhase {
+ public:
+  // margin: how far every fat box reaches beyond its tight box (length).
+  // displacement_multiplier: how many predicted displacements to extend it.
+  explicit BroadPhase(Real margin = Real(0.05), Real displacement_multiplier = Real(2))
+      : margin_(margin), displacement_multiplier_(displacement_multiplier) {}
+
+  // tight: the shape's current world box; displacement: its predicted
+  // motion over the next step (v * dt), zero for static shapes.
+  int createProxy(const Aabb& tight, int user, const Vec3& displacement = Vec3::Zero());
+  void destroyProxy(int handle);
+  // Returns true when the fat box changed (the proxy was re-inserted).
+  bool moveProxy(int handle, const Aabb& tight, const Vec3& displacement = Vec3::Zero());
+
+  // Every pair of proxies whose fat boxes overlap, each once as (lo, hi)
+  // handles with lo < hi, sorted. `out` is overwritten.
+  void updatePairs(std::vector<std::pair<int, int>>& out);
+
+  int user(int handle) const { return proxies_[handle].user; }
+  const Aabb& fatAabb(int handle) const { return proxies_[handle].fat; }
+  bool isInfinite(int handle) const { return proxies_[handle].leaf < 0; }
+  int proxyCount() const { return live_; }
+  const DynamicTree& tree() const { return tree_; }
+
+  // Box-box overlap tests performed by all queries since the last reset.
+  std::uint64_t overlapTests() const { return overlap_tests_; }
+  void resetOverlapTests() { overlap_tests_ = 0; }
+
+  // Calls visit(handle) for every proxy whose fat box overlaps `box`,
+  // infinite proxies included; visit returns false to stop.
+  template <class Visit>
+  void query(const Aabb& box, Visit&& visit) {
+    bool go = true;
+    tree_.query(box, [&](int leaf) { return go = visit(tree_.user(leaf)); }, &overlap_tests_);
+    for (int h : infinite_)
+      if (go && proxies_[h].fat.overlaps(box) && !visit(h)) break;
+  }
+
+ private:
+  struct Proxy {
+    Aabb fat;
+    int user = -1;
+    int leaf = -1;       // tree node; -1 when infinite or free
+    int next_free = -1;
+    bool alive = false;
+    bool moved = false;  // fat box changed since the last updatePairs
+    bool dirty = false;  // its pairs must be recomputed (moved or destroyed)
+  };
+
+  Aabb fatten(const Aabb& tight, const Vec3& displacement) const;
+  void markMoved(int handle);
+
+  Real margin_;
+  Real displacement_multiplier_;
+  DynamicTree tree_;  // leaves' user field holds the proxy handle
+  std::vector<Proxy> proxies_;
+  std::vector<int> infinite_;  // handles of infinite proxies, ascending
+  std::vector<int> moved_;     // handles to re-query, in order of marking
+  std::vector<int> dirty_;     // handles whose old pairs are stale
+  std::vector<std::pair<int, int>> pairs_;
+  std::vector<std::pair<int, int>> fresh_;  // scratch for updatePairs
+  int free_ = -1;
+  int live_ = 0;
+  std::uint64_t overlap_tests_ = 0;
+};
+
+}  // namespace cairn

@@ -1,0 +1,109 @@
+// A dynamic bounding volume hierarchy: a binary tree of AABBs whose leaves
+// are proxies and whose inner nodes bound their two children.
+//
+// Insertion picks the sibling that minimizes the total surface area the
+// tree gains (the surface area heuristic: a query box hits a node with
+// probability proportional to its area, MacDonald and Booth 1990). Pairing
+// the new leaf L with node S under a new parent costs
+//   SA(S u L)                          the new parent's area
+//   + sum over ancestors A of S of SA(A u L) - SA(A)   their growth,
+// and the best S over the whole tree is found by branch and bound: below a
+// node whose ancestors already grew by g, nothing can cost less than
+// SA(L) + g (Bittner, Hapala, Havran 2013; Catto, "Dynamic Bounding Volume
+// Hierarchies", GDC 2019).
+//
+// Balance: after every insert and remove, the path to the root is refitted
+// and each node whose children's heights differ by more than one is rotated
+// (AVL rotation: the taller child moves up and keeps its taller grandchild;
+// children of a BVH node are unordered, so one rotation kind covers the
+// zig-zag case too), so the height stays below 1.44 log2(n + 2) whatever the
+// insertion order and a query costs O(log n + k) node tests for k hits.
+//
+// Storage: one contiguous array of nodes; freed nodes form a free list
+// threaded through `parent`, so inserting and removing never allocate once
+// the array has grown to the peak node count.
+#pragma once
+
+#include "collision/aabb.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace cairn {
+
+class DynamicTree {
+ public:
+  struct Node {
+    Aabb box;
+    int parent = -1;  // next free node while on the free list
+    int child1 = -1;  // -1 for a leaf
+    int child2 = -1;
+    int height = -1;  // 0 for a leaf, -1 for a free node
+    int user = -1;    // leaves only
+    bool isLeaf() const { return child1 < 0; }
+  };
+
+  // Adds a leaf with `box`; returns its node index (stable until removed).
+  int insert(const Aabb& box, int user);
+  void remove(int leaf);
+  // Replaces the leaf's box, re-inserting it (the leaf keeps its index).
+  void update(int leaf, const Aabb& box);
+
+  const Aabb& box(int leaf) const { return nodes_[leaf].box; }
+  int user(int leaf) const { return nodes_[leaf].user; }
+  int root() const { return root_; }
+  const Node& node(int i) const { return nodes_[i]; }
+  int height() const { return root_ < 0 ? 0 : nodes_[root_].height; }
+  int leafCount() const { return leaves_; }
+  // Sum of inner node areas over the root's: the SAH quality measure.
+  Real areaRatio() const;
+  // Structural invariants (parents, heights, enclosing boxes, balance).
+  bool validate() const;
+
+  // Calls visit(leaf) for every leaf whose box overlaps `box`; visit returns
+  // false to stop. Adds the number of box-box tests to *tests if given.
+  template <class Visit>
+  void query(const Aabb& box, Visit&& visit, std::uint64_t* tests = nullptr) const {
+    if (root_ < 0) return;
+    // AVL balance bounds the height by 1.44 log2(n + 2): 128 entries would
+    // need more leaves than memory can hold.
+    int stack[128];
+    int top = 0;
+    stack[top++] = root_;
+    std::uint64_t count = 0;
+    while (top > 0) {
+      const Node& n = nodes_[stack[--top]];
+      ++count;
+      if (!n.box.overlaps(box)) continue;
+      if (n.isLeaf()) {
+        if (!visit(static_cast<int>(&n - nodes_.data()))) break;
+      } else {
+        stack[top++] = n.child1;
+        stack[top++] = n.child2;
+      }
+    }
+    if (tests) *tests += count;
+  }
+
+ private:
+  int allocateNode();
+  void freeNode(int i);
+  void insertLeaf(int leaf);
+  void removeLeaf(int leaf);
+  int rotate(int a);
+  int balance(int a);
+  void refit(int i);
+  void refitUpFrom(int i);
+
+  struct Candidate {
+    int node;
+    Real growth;  // area the ancestors of `node` gain from the new leaf
+  };
+  std::vector<Node> nodes_;
+  std::vector<Candidate> search_;  // insertion's priority queue, reused
+  int root_ = -1;
+  int free_ = -1;
+  int leaves_ = 0;
+};
+
+}  // namespace cairn

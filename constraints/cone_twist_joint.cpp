@@ -38,11 +38,18 @@ void buildConeTwistRows(const Joint& j, const BodyView& a, const BodyView& b, Ro
   coneTwistAngles(j, a, b, swing, twist);
   const Vec3 zero = Vec3::Zero();
 
-  const Vec3 cross = ta.cross(tb);
-  if (cross.norm() > Real(1e-9)) {
-    const Vec3 n = cross.normalized();
+  // Swing axis: t_a x t_b, or, while the axes are aligned, the direction the
+  // relative spin is about to swing them (so a fast swing that would cross
+  // the cone within this step is caught speculatively).
+  Vec3 n = ta.cross(tb);
+  if (n.norm() < Real(1e-9)) {
+    const Vec3 w_rel = b.w - a.w;
+    n = w_rel - ta * ta.dot(w_rel);
+  }
+  if (n.norm() > Real(1e-12)) {
+    n.normalize();
     const Vec3 ref = worldVector(a, j.local_ref_a);
-    const Vec3 dir = tb - ta * ta.dot(tb);  // swing direction in the plane normal to t_a
+    const Vec3 dir = n.cross(ta);  // where t_b leans, in the plane normal to t_a
     const Real phi = std::atan2(dir.dot(ta.cross(ref)), dir.dot(ref));
     const Real c = std::cos(phi) / j.def.swing_span1, sn = std::sin(phi) / j.def.swing_span2;
     LimitDef cone;

@@ -22,7 +22,13 @@ int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, cons
   const ErpCfm soft = resolveSoftness(axis_softness, *ctx.joint_softness, ctx.erp, ctx.cfm, 1 / diag, ctx.h);
   r.cfm = soft.cfm / ctx.h;  // ODE's CFM multiplies a force; lambda is an impulse
   r.inv_diag = 1 / (diag + r.cfm);
-  r.rhs = -soft.erp / ctx.h * c;
+  const bool own_softness = (axis_softness && axis_softness->isSet()) || ctx.joint_softness->isSet();
+  if (ctx.correction != Correction::InRhs && !own_softness) {
+    r.correction = ctx.correction;
+    r.bias_rhs = -soft.erp / ctx.h * c;
+  } else {
+    r.rhs = -soft.erp / ctx.h * c;
+  }
   r.lo = lo;
   r.hi = hi;
   r.kind = ctx.kind;

@@ -41,6 +41,10 @@ struct RowContext {
   std::vector<ConstraintRow>* rows = nullptr;
   const std::vector<Real>* warm = nullptr;  // carried impulses per owner row slot
   Real warm_factor = 1;
+  // How rows with the default softness correct their position error. Rows
+  // with a softness of their own keep it in rhs: there ERP and CFM stand for
+  // a real spring-damper and must act on the velocities in the same solve.
+  Correction correction = Correction::InRhs;
 };
 
 // Appends one row from its Jacobian. C is the position error (the row

@@ -12,7 +12,7 @@
 //                                 deviate in the direction of that bound).
 //
 // rhs carries the position feedback -ERP/h C (plus restitution or a motor's
-// target speed); cfm is ODE's CFM divided by h, because ODE's CFM multiplies
+// target speed) -- unless split impulse is on, see bias_rhs below; cfm is ODE's CFM divided by h, because ODE's CFM multiplies
 // a force and lambda here is an impulse (docs/constraints.md derives it).
 //
 // Friction rows point at their normal row (ODE's findex): their bounds are
@@ -41,6 +41,16 @@ enum class RowKind : std::uint8_t {
 inline constexpr int kRowKindCount = static_cast<int>(RowKind::Count);
 const char* rowKindName(RowKind k);
 
+// Where a row's position feedback -ERP/h C goes (settings.hpp explains the
+// choice). InRhs is ODE's single pass; the other two solve it in a second
+// pass from zero impulses, so warm starting carries only the impulse that
+// holds the constraint, never last step's correction.
+enum class Correction : std::uint8_t {
+  InRhs,           // in rhs with the velocity target (ODE quickstep)
+  VelocityBias,    // second pass, result added to the velocities (Baumgarte)
+  PseudoVelocity   // second pass, result moves positions only (split impulse)
+};
+
 struct ConstraintRow {
   std::int32_t body_a = 0, body_b = 0;  // solver body indices (0 = the world)
   Vec3 j_lin_a = Vec3::Zero(), j_ang_a = Vec3::Zero();
@@ -57,7 +67,9 @@ struct ConstraintRow {
   RowKind kind = RowKind::JointLinear;
   std::int32_t owner = -1;       // joint index or contact index
   std::int8_t owner_row = 0;     // row number inside its owner (warm start key)
-  Real bias_rhs = 0;      // split impulse: position-only target (pseudo velocity)
+  // The position error's target -ERP/h C when it is solved in its own pass.
+  Real bias_rhs = 0;
+  Correction correction = Correction::InRhs;
 };
 
 }  // namespace cairn

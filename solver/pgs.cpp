@@ -76,6 +76,31 @@ PgsStats solvePgs(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, c
   return stats;
 }
 
+bool solvePgsCorrection(std::span<const ConstraintRow> rows, std::span<SolverBody> bodies, Correction which,
+                        const PgsSettings& s, std::vector<Real>& lambda) {
+  bool any = false;
+  for (const ConstraintRow& r : rows) any = any || (r.correction == which && r.bias_rhs != 0);
+  if (!any) return false;
+  lambda.assign(rows.size(), 0);
+  for (int it = 0; it < s.iterations; ++it) {
+    Real max_delta = 0;
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const ConstraintRow& r = rows[i];
+      if (r.correction != which) continue;
+      SolverBody& a = bodies[r.body_a];
+      SolverBody& b = bodies[r.body_b];
+      const Real delta = (r.bias_rhs - rowVelocity(r, a, b) - r.cfm * lambda[i]) * r.inv_diag;
+      const Real next = std::clamp(lambda[i] + s.sor * delta, r.lo, r.hi);
+      const Real d = next - lambda[i];
+      lambda[i] = next;
+      applyImpulse(r, a, b, d);
+      max_delta = std::max(max_delta, std::abs(d));
+    }
+    if (s.tolerance > 0 && max_delta <= s.tolerance) break;
+  }
+  return true;
+}
+
 Real pgsResidual(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {
   // Natural map F_i = lambda_i - clamp(lambda_i - w_i, lo_i, hi_i) with
   // w_i = J_i v - rhs_i + cfm_i lambda_i; zero exactly at an LCP solution.

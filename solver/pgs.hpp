@@ -42,6 +42,15 @@ void applyWarmStart(std::span<const ConstraintRow> rows, std::span<SolverBody> b
 PgsStats solvePgs(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, const PgsSettings& s,
                   std::vector<std::int32_t>& order, std::uint64_t& rng_state);
 
+// The position-correction pass: solves the rows whose correction is `which`
+// for the targets bias_rhs, from zero impulses, adding the result to
+// `bodies` (the real velocities for VelocityBias, a zeroed pseudo-velocity
+// array for PseudoVelocity). Impulses go to the `lambda` scratch so the
+// velocity impulses (warm start, friction bounds) are untouched. Returns
+// false when no row of that kind had an error to correct.
+bool solvePgsCorrection(std::span<const ConstraintRow> rows, std::span<SolverBody> bodies, Correction which,
+                        const PgsSettings& s, std::vector<Real>& lambda);
+
 // Natural-map residual of the mixed LCP at the current impulses and
 // velocities (solver/lcp_residual.hpp has the definition); max norm.
 Real pgsResidual(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies);

@@ -336,6 +336,13 @@ SolverSettings parseSolver(const json& j) {
   s.slop = r.number("slop", s.slop);
   s.restitution_threshold = r.number("restitution_threshold", s.restitution_threshold);
   s.split_impulse = r.boolean("split_impulse", s.split_impulse);
+  if (r.has("position_correction")) {
+    const std::string pc = r.string("position_correction");
+    if (pc == "baumgarte") s.position_correction = Correction::VelocityBias;
+    else if (pc == "split") s.position_correction = Correction::PseudoVelocity;
+    else if (pc == "single_pass") s.position_correction = Correction::InRhs;
+    else r.fail("position_correction", "must be baumgarte, split or single_pass (got '" + pc + "')");
+  }
   s.max_correction_velocity = r.number("max_correction_velocity", s.max_correction_velocity);
   s.max_angular_velocity = r.number("max_angular_velocity", s.max_angular_velocity);
   if (r.has("gyroscopic")) s.gyroscopic = parseGyro(r, r.string("gyroscopic"));

@@ -3,6 +3,7 @@
 // these under "solver" (docs/scene-format.md).
 #pragma once
 
+#include "constraints/row.hpp"
 #include "dynamics/body.hpp"
 #include "dynamics/math.hpp"
 
@@ -25,15 +26,25 @@ struct SolverSettings {
   std::uint64_t seed = 1;
   int substeps = 1;             // sub-steps per step
 
-  // ODE-style softness for joints (and contacts without split impulse).
+  // ODE-style softness: rows drive J v toward -ERP/h C, CFM softens them.
   Real erp = Real(0.2);
   Real cfm = 0;
+  // Position correction of joint rows without a softness of their own:
+  //  VelocityBias   Baumgarte: -ERP/h C joins the velocities, solved in a
+  //                 second pass that is never warm-started (default)
+  //  PseudoVelocity split impulse: the correction moves positions only,
+  //                 adding no energy (but projecting a fast swing loses some)
+  //  InRhs          ODE's single pass: the correction is warm-started with
+  //                 the rest, which re-applies last step's correction and
+  //                 grows unstable on long chains at few iterations
+  // docs/constraints.md measures all three.
+  Correction position_correction = Correction::VelocityBias;
 
   // Contacts (issue: collision).
   Real contact_erp = Real(0.2);
   Real slop = Real(0.005);               // allowed penetration, m
   Real restitution_threshold = Real(0.2); // m/s: slower approach does not bounce
-  bool split_impulse = true;
+  bool split_impulse = true;              // contacts: push out with pseudo-velocities (Bullet's split impulse)
   Real max_correction_velocity = Real(10);  // m/s, clamp on ERP push-out
 
   // Safety nets for the extremes.

@@ -131,6 +131,8 @@ class World {
   std::vector<SavedState> step_start_;
   std::vector<ConstraintRow> rows_;
   std::vector<SolverBody> solver_bodies_;
+  std::vector<SolverBody> pseudo_bodies_;  // split-impulse pseudo-velocities (index as solver bodies)
+  std::vector<Real> pseudo_lambda_;
   std::vector<std::int32_t> order_scratch_;
   std::uint64_t rng_state_ = 0;
   bool rng_seeded_ = false;

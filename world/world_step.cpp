@@ -68,6 +68,7 @@ void World::buildRows(Real h) {
     ctx.rows = &rows_;
     ctx.warm = settings_.warm_start ? &j.warm : nullptr;
     ctx.warm_factor = settings_.warm_start_factor;
+    ctx.correction = settings_.position_correction;
     buildJointRows(j, view(j.def.body_a), view(j.def.body_b), ctx, jrs);
   }
   stats_.rows = static_cast<int>(rows_.size());
@@ -92,6 +93,14 @@ void World::solveRows() {
   const PgsStats st = solvePgs(rows_, solver_bodies_, ps, order_scratch_, rng_state_);
   stats_.iterations += st.iterations;
   stats_.residual = pgsResidual(rows_, solver_bodies_);
+  // Position correction in its own passes (constraints/row.hpp, Correction):
+  // Baumgarte's bias velocities join the state; split impulse's
+  // pseudo-velocities move the bodies this step but add no momentum or
+  // kinetic energy.
+  solvePgsCorrection(rows_, solver_bodies_, Correction::VelocityBias, ps, pseudo_lambda_);
+  pseudo_bodies_.assign(solver_bodies_.size(), SolverBody{});
+  if (!solvePgsCorrection(rows_, pseudo_bodies_, Correction::PseudoVelocity, ps, pseudo_lambda_))
+    pseudo_bodies_.clear();
   for (size_t i = 0; i < bodies_.size(); ++i) {
     if (!bodies_[i].isDynamic()) continue;
     bodies_[i].linear_velocity = solver_bodies_[i + 1].v;
@@ -151,8 +160,19 @@ void World::integrateVelocities(Real h) {
 }
 
 void World::integratePositions(Real h) {
-  for (size_t i = 0; i < bodies_.size(); ++i)
-    integratePosition(bodies_[i], h, settings_.orientation, orientation_offset_[i]);
+  const bool pseudo = pseudo_bodies_.size() == bodies_.size() + 1;
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    Body& b = bodies_[i];
+    if (pseudo && b.isDynamic()) {
+      // Positions move at v + v_pseudo; the state velocity stays v.
+      const SolverBody& p = pseudo_bodies_[i + 1];
+      b.position += h * p.v;
+      integratePosition(b, h, settings_.orientation, orientation_offset_[i] + p.w);
+    } else {
+      integratePosition(b, h, settings_.orientation, orientation_offset_[i]);
+    }
+  }
+  pseudo_bodies_.clear();
 }
 
 void World::clearAccumulators() {

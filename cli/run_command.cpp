@@ -28,6 +28,48 @@ struct RunOptions {
   std::string metrics;
 };
 
+// Figures gathered over a run for the metrics file.
+struct RunFigures {
+  long iterations = 0;
+  Real residual_max = 0, residual_final = 0;
+  Real joint_linear_max = 0, joint_angular_max = 0;
+  int rows_max = 0;
+  int rows_by_kind_max[kRowKindCount] = {};
+  std::vector<std::string> broken;
+
+  void record(const World& w) {
+    const StepStats& st = w.lastStepStats();
+    iterations += st.iterations;
+    residual_final = st.residual;
+    residual_max = std::max(residual_max, st.residual);
+    rows_max = std::max(rows_max, st.rows);
+    for (int k = 0; k < kRowKindCount; ++k) rows_by_kind_max[k] = std::max(rows_by_kind_max[k], st.rows_by_kind[k]);
+    for (int j = 0; j < w.jointCount(); ++j) {
+      const JointError e = w.jointError(JointId{j});
+      joint_linear_max = std::max(joint_linear_max, e.linear);
+      joint_angular_max = std::max(joint_angular_max, e.angular);
+    }
+    for (const auto& e : w.jointBreakEvents()) broken.push_back(e.name);
+  }
+
+  void write(nlohmann::json& m, const World& w) const {
+    const int steps = std::max(1, w.stepCount());
+    m["iterations_total"] = iterations;
+    m["iterations_per_step"] = double(iterations) / steps;
+    m["residual_final"] = residual_final;
+    m["residual_max"] = residual_max;
+    m["residual_definition"] = "max_i |lambda_i - clamp(lambda_i - w_i, lo_i, hi_i)|, w = J v - rhs + cfm lambda";
+    m["rows_max"] = rows_max;
+    nlohmann::json kinds = nlohmann::json::object();
+    for (int k = 0; k < kRowKindCount; ++k) kinds[rowKindName(static_cast<RowKind>(k))] = rows_by_kind_max[k];
+    m["rows_by_kind_max"] = kinds;
+    m["joint_count"] = w.jointCount();
+    m["joint_error_linear_max_m"] = joint_linear_max;
+    m["joint_error_angular_max_rad"] = joint_angular_max;
+    m["joints_broken"] = broken;
+  }
+};
+
 // Shortest text that reads back to the same double (round-trip exact).
 void putNumber(std::string& line, double v) {
   char buf[32];
@@ -94,10 +136,12 @@ int runScene(const RunOptions& opt) {
     appendRows(csv, world, 0);
   }
   const Real e0 = world.kineticEnergy() + world.potentialEnergy();
+  RunFigures fig;
   const auto t0 = std::chrono::steady_clock::now();
   int status = 0;
   for (int s = 1; s <= scene.steps; ++s) {
     world.step(scene.dt);
+    fig.record(world);
     if (!world.numericalEvents().empty()) {
       const auto& ev = world.numericalEvents().front();
       std::cerr << "cairn run: " << opt.scene << ": body '" << ev.body_name << "': non-finite state in "
@@ -122,6 +166,7 @@ int runScene(const RunOptions& opt) {
       m["wall_time_per_step_ms"] = world.stepCount() ? 1e3 * wall / world.stepCount() : 0.0;
       m["energy_initial"] = e0;
       m["energy_final"] = world.kineticEnergy() + world.potentialEnergy();
+      fig.write(m, world);
       writeAtomically(opt.metrics, m.dump(2) + "\n");
     }
   } catch (const InputError& e) {

@@ -8,5 +8,6 @@
 namespace cairn::cli {
 
 void addRunCommand(CLI::App& app, int& status);
+void addSoftnessCommand(CLI::App& app, int& status);
 
 }  // namespace cairn::cli

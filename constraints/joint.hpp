@@ -77,10 +77,6 @@ struct JointError {
 };
 JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& b);
 
-// World-frame anchors and axes of a joint at the bodies' current poses.
-inline Vec3 worldPoint(const BodyView& v, const Vec3& local) { return v.x + v.q * local; }
-inline Vec3 worldVector(const BodyView& v, const Vec3& local) { return v.q * local; }
-
 // Per-type row builders (one file each).
 void buildBallRows(const Joint&, const BodyView&, const BodyView&, RowContext&);
 void buildHingeRows(const Joint&, const BodyView&, const BodyView&, RowContext&, const JointRowSettings&);

@@ -30,6 +30,10 @@ struct BodyView {
   Vec3 v = Vec3::Zero(), w = Vec3::Zero();
 };
 
+// World-frame points and vectors fixed in a body, at its current pose.
+inline Vec3 worldPoint(const BodyView& v, const Vec3& local) { return v.x + v.q * local; }
+inline Vec3 worldVector(const BodyView& v, const Vec3& local) { return v.q * local; }
+
 // Everything a row builder needs besides the bodies.
 struct RowContext {
   Real h = Real(1) / 60;

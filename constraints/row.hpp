@@ -16,7 +16,9 @@
 // a force and lambda here is an impulse (docs/constraints.md derives it).
 //
 // Friction rows point at their normal row (ODE's findex): their bounds are
-// -+ mu lambda_normal, updated during the solve.
+// -+ mu lambda_normal, updated during the solve. Rows are solved island by
+// island, and normal_row counts from the first row of the island, so a
+// solver handed one island's span finds the normal row in that span.
 //
 // The row caches M^-1 J^T for both bodies and 1 / (A_ii + cfm) so that the
 // PGS inner loop is a dot product, a clamp and two axpy's.
@@ -63,7 +65,7 @@ struct ConstraintRow {
   Real lo = -kInf, hi = kInf;
   Real lambda = 0;        // accumulated impulse (warm-started)
   Real mu = 0;            // friction coefficient when normal_row >= 0
-  std::int32_t normal_row = -1;  // friction: index of the normal row in the same block
+  std::int32_t normal_row = -1;  // friction: index of its normal row, counted from the island's first row
   RowKind kind = RowKind::JointLinear;
   std::int32_t owner = -1;       // joint index or contact index
   std::int8_t owner_row = 0;     // row number inside its owner (warm start key)

@@ -14,6 +14,7 @@
 #include "collision/shape.hpp"
 #include "dynamics/math.hpp"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -70,7 +71,17 @@ struct Body {
   Real restitution = 0;
   Real linear_damping = 0;   // 1/s: v *= 1 / (1 + h c)
   Real angular_damping = 0;
-  bool ccd = false;          // continuous collision for fast bodies
+  Real rolling_friction = 0;    // m: rolling resistance torque <= this * normal force
+  Real torsional_friction = 0;  // m: spinning resistance about the contact normal
+  bool ccd = false;          // speculative contacts reach as far as the body moves in a step
+
+  // Collision filter: a and b collide when (a.group & b.mask) and (b.group & a.mask).
+  std::uint32_t collision_group = 1;
+  std::uint32_t collision_mask = 0xffffffffu;
+
+  // Sleeping (world/islands.cpp).
+  bool asleep = false;
+  Real sleep_timer = 0;  // seconds spent below the sleep thresholds
 
   // Shapes in the body frame: positions relative to the center of mass.
   std::vector<ShapeDesc> shapes;

@@ -41,6 +41,8 @@ struct BodyDef {
   std::vector<ShapeDesc> shapes;
   Real friction = Real(0.5);
   Real restitution = 0;
+  Real rolling_friction = 0;    // m
+  Real torsional_friction = 0;  // m
   Real linear_damping = 0;
   Real angular_damping = 0;
   bool ccd = false;

@@ -186,6 +186,8 @@ BodyDef parseBody(const json& j, size_t index, const std::filesystem::path& base
   b.angular_velocity = r.vec3("angular_velocity", Vec3::Zero());
   b.friction = r.number("friction", b.friction);
   b.restitution = r.number("restitution", b.restitution);
+  b.rolling_friction = r.number("rolling_friction", 0);
+  b.torsional_friction = r.number("torsional_friction", 0);
   b.linear_damping = r.number("linear_damping", 0);
   b.angular_damping = r.number("angular_damping", 0);
   b.ccd = r.boolean("ccd", false);
@@ -344,6 +346,11 @@ SolverSettings parseSolver(const json& j) {
     else r.fail("position_correction", "must be baumgarte, split or single_pass (got '" + pc + "')");
   }
   s.max_correction_velocity = r.number("max_correction_velocity", s.max_correction_velocity);
+  s.contact_margin = r.number("contact_margin", s.contact_margin);
+  s.sleeping = r.boolean("sleeping", s.sleeping);
+  s.sleep_linear_velocity = r.number("sleep_linear_velocity", s.sleep_linear_velocity);
+  s.sleep_angular_velocity = r.number("sleep_angular_velocity", s.sleep_angular_velocity);
+  s.sleep_time = r.number("sleep_time", s.sleep_time);
   s.max_angular_velocity = r.number("max_angular_velocity", s.max_angular_velocity);
   if (r.has("gyroscopic")) s.gyroscopic = parseGyro(r, r.string("gyroscopic"));
   if (r.has("orientation")) {

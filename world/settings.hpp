@@ -47,6 +47,15 @@ struct SolverSettings {
   bool split_impulse = true;              // contacts: push out with pseudo-velocities (Bullet's split impulse)
   Real max_correction_velocity = Real(10);  // m/s, clamp on ERP push-out
 
+  Real contact_margin = Real(0.02);  // m: contacts are made this far before touching (speculative)
+
+  // Sleeping: an island whose bodies all stay below both speeds for
+  // sleep_time seconds sleeps and costs nothing until woken.
+  bool sleeping = true;
+  Real sleep_linear_velocity = Real(0.05);   // m/s
+  Real sleep_angular_velocity = Real(0.05);  // rad/s
+  Real sleep_time = Real(0.5);               // s
+
   // Safety nets for the extremes.
   Real max_angular_velocity = kInf;  // rad/s, per body
 

@@ -109,6 +109,10 @@ void validateSettings(const SolverSettings& s) {
   requireNonNegative(o, "restitution_threshold", s.restitution_threshold);
   if (!(s.max_correction_velocity > 0)) throw InputError(o, "max_correction_velocity", "must be positive");
   if (!(s.max_angular_velocity > 0)) throw InputError(o, "max_angular_velocity", "must be positive");
+  requireNonNegative(o, "contact_margin", s.contact_margin);
+  requireNonNegative(o, "sleep_linear_velocity", s.sleep_linear_velocity);
+  requireNonNegative(o, "sleep_angular_velocity", s.sleep_angular_velocity);
+  requireNonNegative(o, "sleep_time", s.sleep_time);
 }
 
 BodyId World::createBody(const BodyDef& def) {
@@ -124,6 +128,8 @@ BodyId World::createBody(const BodyDef& def) {
   requireNonNegative(obj, "friction", def.friction);
   if (!finite(def.restitution) || def.restitution < 0 || def.restitution > 1)
     throw InputError(obj, "restitution", "must lie in [0, 1] (got " + num(def.restitution) + ")");
+  requireNonNegative(obj, "rolling_friction", def.rolling_friction);
+  requireNonNegative(obj, "torsional_friction", def.torsional_friction);
   requireNonNegative(obj, "linear_damping", def.linear_damping);
   requireNonNegative(obj, "angular_damping", def.angular_damping);
   for (size_t i = 0; i < def.shapes.size(); ++i)
@@ -138,6 +144,10 @@ BodyId World::createBody(const BodyDef& def) {
   b.linear_damping = def.linear_damping;
   b.angular_damping = def.angular_damping;
   b.ccd = def.ccd;
+  b.rolling_friction = def.rolling_friction;
+  b.torsional_friction = def.torsional_friction;
+  b.collision_group = def.collision_group;
+  b.collision_mask = def.collision_mask;
   b.shapes = def.shapes;
   for (auto& s : b.shapes) s.local.q.normalize();
 
@@ -190,7 +200,11 @@ BodyId World::createBody(const BodyDef& def) {
   bodies_.push_back(std::move(b));
   orientation_offset_.push_back(Vec3::Zero());
   step_start_.push_back({});
-  return BodyId{static_cast<std::int32_t>(bodies_.size() - 1)};
+  sleep_island_.push_back(-1);
+  body_island_.push_back(-1);
+  const BodyId id{static_cast<std::int32_t>(bodies_.size() - 1)};
+  registerShapes(id);
+  return id;
 }
 
 int World::createSpring(const SpringDef& def) {
@@ -222,12 +236,21 @@ BodyId World::findBody(const std::string& name) const {
   return kWorldBody;
 }
 
+// Pushing a body wakes it (and its island).
 void World::applyForce(BodyId id, const Vec3& force, const Vec3& world_point) {
+  wakeBody(id);
   applyForceAtPoint(body(id), force, world_point);
 }
-void World::applyCentralForce(BodyId id, const Vec3& force) { body(id).force += force; }
-void World::applyTorque(BodyId id, const Vec3& torque) { body(id).torque += torque; }
+void World::applyCentralForce(BodyId id, const Vec3& force) {
+  wakeBody(id);
+  body(id).force += force;
+}
+void World::applyTorque(BodyId id, const Vec3& torque) {
+  wakeBody(id);
+  body(id).torque += torque;
+}
 void World::applyImpulse(BodyId id, const Vec3& impulse, const Vec3& world_point) {
+  wakeBody(id);
   applyImpulseAtPoint(body(id), impulse, world_point);
 }
 

@@ -3,6 +3,9 @@
 // (world/world_step.cpp reads top to bottom as that pipeline).
 #pragma once
 
+#include "collision/broadphase.hpp"
+#include "collision/manifold.hpp"
+#include "constraints/contact.hpp"
 #include "constraints/joint.hpp"
 #include "constraints/row.hpp"
 #include "dynamics/body.hpp"
@@ -10,6 +13,7 @@
 #include "world/defs.hpp"
 #include "world/settings.hpp"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,6 +30,11 @@ struct StepStats {
   int iterations = 0;      // PGS sweeps done (summed over substeps)
   Real residual = 0;       // natural-map LCP residual after the solve (max norm, last substep)
   int rows = 0;            // rows solved (last substep)
+  int contacts = 0;        // touching manifolds
+  int contact_points = 0;
+  int islands = 0;         // awake islands solved
+  int sleeping_bodies = 0;
+  Real max_penetration = 0;  // deepest contact after the step (m)
   int rows_by_kind[kRowKindCount] = {};
   double wall_seconds = 0;
 };
@@ -36,6 +45,41 @@ struct JointBreakEvent {
   JointId joint;
   std::string name;
   Real force = 0, torque = 0;
+};
+
+// Contacts begun and ended, for sounds and damage: read after the step.
+struct ContactEvent {
+  enum class Type { Begin, End } type = Type::Begin;
+  int step = 0;
+  BodyId body_a, body_b;
+  std::int32_t shape_a = -1, shape_b = -1;
+  Vec3 point = Vec3::Zero();   // deepest point (world)
+  Vec3 normal = Vec3::Zero();  // from a to b
+  Real impulse = 0;            // total normal impulse of the step (N s); 0 for End
+};
+
+// What a contact callback sees and may change, once per manifold per step
+// before any row is built: veto (enabled = false, e.g. a one-way platform),
+// or change friction and restitution for this contact.
+struct ContactInfo {
+  BodyId body_a, body_b;
+  std::int32_t shape_a = -1, shape_b = -1;
+  Vec3 normal = Vec3::Zero();  // from a to b
+  int count = 0;
+  Vec3 points[4];
+  Real depths[4] = {};
+  Vec3 relative_velocity = Vec3::Zero();  // of b's deepest point relative to a's
+  Real friction = 0, restitution = 0;
+  bool enabled = true;
+};
+using ContactCallback = std::function<void(ContactInfo&)>;
+
+// A shape in the World: which body and which of its shapes, and its
+// broadphase proxy.
+struct ShapeRef {
+  BodyId body;
+  std::int32_t index = 0;
+  std::int32_t proxy = -1;
 };
 
 // A non-finite value caught by the guard: which body and which stage.
@@ -83,6 +127,22 @@ class World {
   // Scripted motion of a kinematic body.
   void setKinematicVelocity(BodyId id, const Vec3& linear, const Vec3& angular);
 
+  // --- Contacts
+  const std::vector<Contact>& contacts() const { return contacts_; }
+  const std::vector<ContactEvent>& contactEvents() const { return contact_events_; }
+  void setContactCallback(ContactCallback cb) { contact_callback_ = std::move(cb); }
+  // Friction and restitution for one body pair, replacing the combination
+  // (geometric-mean friction, larger restitution).
+  void setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution);
+  const std::vector<ShapeRef>& shapes() const { return shapes_; }
+  const BroadPhase& broadPhase() const { return broadphase_; }
+  // Deepest penetration among touching contacts now (m, >= 0).
+  Real maxPenetration() const;
+
+  // --- Sleeping
+  void wakeBody(BodyId id);
+  bool isAsleep(BodyId id) const { return body(id).asleep; }
+
   // --- Settings
   const Vec3& gravity() const { return gravity_; }
   void setGravity(const Vec3& g);
@@ -111,6 +171,13 @@ class World {
   void integrateVelocities(Real h);
   void integratePositions(Real h);
   BodyView view(BodyId id) const;
+  void registerShapes(BodyId id);
+  void detectContacts(Real h);
+  bool shouldCollide(const Body& a, const Body& b, BodyId ia, BodyId ib) const;
+  void emitContactEvents(const std::vector<Contact>& old);
+  void buildIslands();
+  void updateSleep(Real h);
+  void wakeIsland(std::int32_t island);
   void buildRows(Real h);
   void solveRows();
   void storeImpulses(Real h);
@@ -124,6 +191,23 @@ class World {
   std::vector<Body> bodies_;
   std::vector<Spring> springs_;
   std::vector<Joint> joints_;
+  std::vector<ShapeRef> shapes_;
+  BroadPhase broadphase_;
+  std::vector<Contact> contacts_;       // sorted by key
+  std::vector<Contact> old_contacts_;   // scratch: last step's, for matching
+  std::vector<std::pair<int, int>> pairs_;
+  std::vector<Manifold> manifolds_;
+  std::vector<ContactEvent> contact_events_;
+  ContactCallback contact_callback_;
+  struct PairMaterial { std::uint64_t key; Real friction, restitution; };
+  std::vector<PairMaterial> pair_materials_;  // sorted by key
+  // Islands: per body (dynamic, awake) its island, -1 otherwise; rows are
+  // built island by island and island_rows_ holds each island's range.
+  std::vector<std::int32_t> body_island_;
+  std::vector<std::int32_t> uf_parent_;
+  std::vector<std::pair<std::int32_t, std::int32_t>> island_rows_;
+  std::vector<std::int32_t> sleep_island_;  // per body: the island it fell asleep with
+  int island_count_ = 0;
 
   // Per-step working arrays (sized once, reused: no allocation per step).
   std::vector<Vec3> orientation_offset_;

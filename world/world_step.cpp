@@ -2,14 +2,20 @@
 // chapter), top to bottom:
 //
 //   1. forces       springs and user forces into the accumulators
-//   2. velocities   v* = v + h M^-1 f (gravity, gyroscopic term, damping)
-//   3. collision    broadphase -> narrowphase -> contact manifolds
-//   4. rows         contacts, joints, limits, motors -> Jacobian rows
-//   5. solve        lambda from the rows; v = v* + M^-1 J^T lambda
-//   6. positions    x += h v, q <- exp(h w) q
-//   7. clean up     clear accumulators; guard against non-finite state
+//   2. collision    broadphase -> narrowphase -> contact cache -> callback
+//   3. islands      wake what was touched; group awake bodies
+//   for each of the n substeps (h / n each; Box2D v3's soft step):
+//     4. velocities   v* = v + h M^-1 f (gravity, gyroscopic term, damping)
+//     5. rows         joints, limits, motors, contacts -> Jacobian rows, island by island
+//     6. solve        PGS per island: v = v* + M^-1 J^T lambda; then the
+//                     position-correction pass (Baumgarte or split impulse)
+//     7. positions    x += h v, q <- exp(h w) q
+//     8. impulses     kept for warm starting; joint feedback and breaking
+//   9. events, sleep, clear accumulators
 //
-// Stages 3 to 5 are filled by the collision and constraint modules.
+// Collision runs first, on the positions the step starts from, so that
+// restitution sees the approach speed before gravity is added (stage 4).
+// A guard after each stage puts back any body whose state went non-finite.
 #include "dynamics/error.hpp"
 #include "dynamics/forces.hpp"
 #include "dynamics/integrate.hpp"
@@ -27,56 +33,119 @@ void World::step(Real h) {
   const auto t0 = std::chrono::steady_clock::now();
   saveStepStart();
   break_events_.clear();
+  contact_events_.clear();
   stats_ = StepStats{};
 
-  // Substeps repeat stages 2 to 6 with h / n, the forces held for the step
-  // (Box2D v3's soft step: accuracy bought with substeps, not iterations).
   const int n = settings_.substeps;
   const Real hs = h / n;
   applyExternalForces();                                  // 1
-  // 3: collision detection (the collision module) runs once per step here.
+  detectContacts(h);                                      // 2
+  buildIslands();                                         // 3
   for (int sub = 0; sub < n; ++sub) {
-    integrateVelocities(hs);                              // 2
+    integrateVelocities(hs);                              // 4
     if (!guardFinite("velocity integration")) break;
-    buildRows(hs);                                        // 4
-    solveRows();                                          // 5
+    buildRows(hs);                                        // 5
+    solveRows();                                          // 6
     if (!guardFinite("constraint solve")) break;
-    integratePositions(hs);                               // 6
+    integratePositions(hs);                               // 7
     if (!guardFinite("position integration")) break;
-    storeImpulses(hs);
+    storeImpulses(hs);                                    // 8
   }
-  clearAccumulators();                                    // 7
+  emitContactEvents(old_contacts_);                       // 9
+  updateSleep(h);
+  clearAccumulators();
 
+  for (const Contact& c : contacts_) {
+    if (!c.enabled) continue;
+    ++stats_.contacts;
+    stats_.contact_points += c.count;
+  }
+  stats_.islands = island_count_;
+  stats_.max_penetration = maxPenetration();
   ++step_count_;
   time_ += h;
   stats_.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Stage 4: every active joint writes its rows (constraints/*_joint.cpp).
+// Stage 5: rows island by island, so each island is solved on its own.
 void World::buildRows(Real h) {
   rows_.clear();
+  island_rows_.clear();
   const JointRowSettings jrs{settings_.restitution_threshold};
-  for (size_t i = 0; i < joints_.size(); ++i) {
-    const Joint& j = joints_[i];
-    if (j.broken) continue;
-    RowContext ctx;
-    ctx.h = h;
-    ctx.erp = settings_.erp;
-    ctx.cfm = settings_.cfm;
-    ctx.joint_softness = &j.def.softness;
-    ctx.owner = static_cast<std::int32_t>(i);
-    ctx.rows = &rows_;
-    ctx.warm = settings_.warm_start ? &j.warm : nullptr;
-    ctx.warm_factor = settings_.warm_start_factor;
-    ctx.correction = settings_.position_correction;
-    buildJointRows(j, view(j.def.body_a), view(j.def.body_b), ctx, jrs);
+  ContactRowSettings crs;
+  crs.h = h;
+  crs.contact_erp = settings_.contact_erp;
+  crs.cfm = settings_.cfm;
+  crs.slop = settings_.slop;
+  crs.restitution_threshold = settings_.restitution_threshold;
+  crs.max_correction_velocity = settings_.max_correction_velocity;
+  crs.correction = settings_.split_impulse ? Correction::PseudoVelocity : settings_.position_correction;
+  crs.warm_start = settings_.warm_start;
+  crs.warm_start_factor = settings_.warm_start_factor;
+
+  // The island of a constraint is that of its dynamic, awake body (-1: none
+  // awake, so it makes no rows).
+  const auto islandOf = [&](BodyId a, BodyId b) {
+    const std::int32_t ia = a.isWorld() ? -1 : body_island_[static_cast<size_t>(a.index)];
+    return ia >= 0 ? ia : (b.isWorld() ? -1 : body_island_[static_cast<size_t>(b.index)]);
+  };
+  // Bucket joints and contacts by island (counting sort keeps the order).
+  std::vector<std::int32_t> joint_start(static_cast<size_t>(island_count_) + 1, 0);
+  std::vector<std::int32_t> contact_start(static_cast<size_t>(island_count_) + 1, 0);
+  for (const Joint& j : joints_)
+    if (!j.broken)
+      if (const std::int32_t isl = islandOf(j.def.body_a, j.def.body_b); isl >= 0) ++joint_start[static_cast<size_t>(isl) + 1];
+  for (const Contact& c : contacts_)
+    if (c.enabled)
+      if (const std::int32_t isl = islandOf(c.body_a, c.body_b); isl >= 0) ++contact_start[static_cast<size_t>(isl) + 1];
+  for (size_t i = 1; i < joint_start.size(); ++i) {
+    joint_start[i] += joint_start[i - 1];
+    contact_start[i] += contact_start[i - 1];
+  }
+  std::vector<std::int32_t> joint_order(static_cast<size_t>(joint_start.back()));
+  std::vector<std::int32_t> contact_order(static_cast<size_t>(contact_start.back()));
+  {
+    std::vector<std::int32_t> jf(joint_start.begin(), joint_start.end() - 1), cf(contact_start.begin(), contact_start.end() - 1);
+    for (size_t i = 0; i < joints_.size(); ++i)
+      if (!joints_[i].broken)
+        if (const std::int32_t isl = islandOf(joints_[i].def.body_a, joints_[i].def.body_b); isl >= 0)
+          joint_order[static_cast<size_t>(jf[static_cast<size_t>(isl)]++)] = static_cast<std::int32_t>(i);
+    for (size_t i = 0; i < contacts_.size(); ++i)
+      if (contacts_[i].enabled)
+        if (const std::int32_t isl = islandOf(contacts_[i].body_a, contacts_[i].body_b); isl >= 0)
+          contact_order[static_cast<size_t>(cf[static_cast<size_t>(isl)]++)] = static_cast<std::int32_t>(i);
+  }
+
+  for (std::int32_t isl = 0; isl < island_count_; ++isl) {
+    const auto begin = static_cast<std::int32_t>(rows_.size());
+    for (std::int32_t k = joint_start[static_cast<size_t>(isl)]; k < joint_start[static_cast<size_t>(isl) + 1]; ++k) {
+      const auto i = static_cast<size_t>(joint_order[static_cast<size_t>(k)]);
+      const Joint& j = joints_[i];
+      RowContext ctx;
+      ctx.h = h;
+      ctx.erp = settings_.erp;
+      ctx.cfm = settings_.cfm;
+      ctx.joint_softness = &j.def.softness;
+      ctx.owner = static_cast<std::int32_t>(i);
+      ctx.rows = &rows_;
+      ctx.warm = settings_.warm_start ? &j.warm : nullptr;
+      ctx.warm_factor = settings_.warm_start_factor;
+      ctx.correction = settings_.position_correction;
+      buildJointRows(j, view(j.def.body_a), view(j.def.body_b), ctx, jrs);
+    }
+    for (std::int32_t k = contact_start[static_cast<size_t>(isl)]; k < contact_start[static_cast<size_t>(isl) + 1]; ++k) {
+      const auto i = static_cast<size_t>(contact_order[static_cast<size_t>(k)]);
+      Contact& c = contacts_[i];
+      buildContactRows(c, static_cast<std::int32_t>(i), view(c.body_a), view(c.body_b), crs, begin, rows_);
+    }
+    island_rows_.emplace_back(begin, static_cast<std::int32_t>(rows_.size()));
   }
   stats_.rows = static_cast<int>(rows_.size());
   for (int& k : stats_.rows_by_kind) k = 0;
   for (const ConstraintRow& r : rows_) ++stats_.rows_by_kind[static_cast<int>(r.kind)];
 }
 
-// Stage 5: v = v* + M^-1 J^T lambda with lambda from the chosen solver.
+// Stage 6: v = v* + M^-1 J^T lambda, island by island.
 void World::solveRows() {
   if (rows_.empty()) return;
   solver_bodies_.resize(bodies_.size() + 1);
@@ -87,12 +156,18 @@ void World::solveRows() {
     rng_state_ = settings_.seed;
     rng_seeded_ = true;
   }
-  applyWarmStart(rows_, solver_bodies_);
   const PgsSettings ps{settings_.iterations, settings_.tolerance, settings_.sor, settings_.randomize_order,
                        settings_.seed};
-  const PgsStats st = solvePgs(rows_, solver_bodies_, ps, order_scratch_, rng_state_);
-  stats_.iterations += st.iterations;
-  stats_.residual = pgsResidual(rows_, solver_bodies_);
+  std::span<ConstraintRow> all(rows_);
+  Real residual = 0;
+  for (const auto& [begin, end] : island_rows_) {
+    std::span<ConstraintRow> rows = all.subspan(static_cast<size_t>(begin), static_cast<size_t>(end - begin));
+    applyWarmStart(rows, solver_bodies_);
+    const PgsStats st = solvePgs(rows, solver_bodies_, ps, order_scratch_, rng_state_);
+    stats_.iterations = std::max(stats_.iterations, st.iterations);
+    residual = std::max(residual, pgsResidual(rows, solver_bodies_));
+  }
+  stats_.residual = residual;
   // Position correction in its own passes (constraints/row.hpp, Correction):
   // Baumgarte's bias velocities join the state; split impulse's
   // pseudo-velocities move the bodies this step but add no momentum or
@@ -102,15 +177,15 @@ void World::solveRows() {
   if (!solvePgsCorrection(rows_, pseudo_bodies_, Correction::PseudoVelocity, ps, pseudo_lambda_))
     pseudo_bodies_.clear();
   for (size_t i = 0; i < bodies_.size(); ++i) {
-    if (!bodies_[i].isDynamic()) continue;
+    if (!bodies_[i].isDynamic() || bodies_[i].asleep) continue;
     bodies_[i].linear_velocity = solver_bodies_[i + 1].v;
     bodies_[i].angular_velocity = solver_bodies_[i + 1].w;
   }
 }
 
-// Keeps each row's impulse for warm starting, turns the impulses into the
-// joints' force feedback (lambda / h through J), and breaks joints whose
-// force or torque exceeded their threshold.
+// Stage 8: keeps each row's impulse for warm starting, turns the impulses
+// into the joints' force feedback (lambda / h through J), and breaks joints
+// whose force or torque exceeded their threshold.
 void World::storeImpulses(Real h) {
   for (Joint& j : joints_) {
     std::fill(j.warm.begin(), j.warm.end(), Real(0));
@@ -126,6 +201,8 @@ void World::storeImpulses(Real h) {
     j.feedback.force_b += r.j_lin_b * f;
     j.feedback.torque_b += r.j_ang_b * f;
   }
+  for (Contact& c : contacts_)
+    if (c.enabled) storeContactImpulses(c, rows_);
   for (size_t i = 0; i < joints_.size(); ++i) {
     Joint& j = joints_[i];
     if (j.broken) continue;
@@ -151,8 +228,9 @@ void World::applyExternalForces() {
 
 void World::integrateVelocities(Real h) {
   for (size_t i = 0; i < bodies_.size(); ++i) {
-    orientation_offset_[i] = integrateVelocity(bodies_[i], gravity_, h, settings_.gyroscopic);
     Body& b = bodies_[i];
+    if (b.asleep) continue;
+    orientation_offset_[i] = integrateVelocity(b, gravity_, h, settings_.gyroscopic);
     // Safety net: cap the spin rate (off by default).
     const Real w = b.angular_velocity.norm();
     if (w > settings_.max_angular_velocity) b.angular_velocity *= settings_.max_angular_velocity / w;
@@ -163,6 +241,7 @@ void World::integratePositions(Real h) {
   const bool pseudo = pseudo_bodies_.size() == bodies_.size() + 1;
   for (size_t i = 0; i < bodies_.size(); ++i) {
     Body& b = bodies_[i];
+    if (b.asleep) continue;
     if (pseudo && b.isDynamic()) {
       // Positions move at v + v_pseudo; the state velocity stays v.
       const SolverBody& p = pseudo_bodies_[i + 1];

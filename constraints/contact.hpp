@@ -1,0 +1,86 @@
+// Contact constraints: a persistent manifold between two shapes and the rows
+// it writes each (sub)step.
+//
+// For a point with anchors p_a on A's surface and p_b on B's, normal n from
+// A to B and separation s = (p_b - p_a).n (negative when penetrating):
+//
+//   normal row    J = [-n, -(r_a x n), n, r_b x n],  lambda >= 0
+//                 rhs = -s/h while separated (speculative: close the gap,
+//                 no more); Newton's restitution -e v_n0 when the approach
+//                 speed v_n0 (at detection) exceeds the threshold; the
+//                 penetration beyond the slop is pushed out at
+//                 contact_erp/h per step (split impulse or Baumgarte).
+//   friction rows along t1 (the sliding direction when sliding) and
+//                 t2 = n x t1, |lambda_t| <= mu lambda_n (pyramid; the
+//                 bounds follow the normal row during the solve)
+//   rolling rows  optional: torsional about n and rolling about t1, t2,
+//                 |lambda| <= coefficient * lambda_n of the deepest point
+//                 times the point count (one set per manifold)
+#pragma once
+
+#include "constraints/parts.hpp"
+#include "world/defs.hpp"
+
+#include <cstdint>
+
+namespace cairn {
+
+struct ContactPointState {
+  std::uint32_t feature_id = 0;
+  Vec3 local_a = Vec3::Zero();   // anchor on A's surface, A's frame (from its center of mass)
+  Vec3 local_b = Vec3::Zero();   // anchor on B's surface, B's frame
+  Real depth = 0;                // at detection (> 0 penetrating)
+  Real approach_speed = 0;       // relative normal velocity at detection (< 0 approaching)
+  Real normal_impulse = 0;       // accumulated, carried for warm starting
+  Vec3 friction_impulse = Vec3::Zero();  // accumulated tangential impulse, world vector
+  std::int32_t normal_row = -1;  // this (sub)step's row index
+  std::int32_t friction_row = -1;  // first of two
+};
+
+struct Contact {
+  std::int32_t shape_a = -1, shape_b = -1;  // world shape indices, shape_a < shape_b
+  std::int32_t triangle = -1;               // mesh triangle, else -1
+  BodyId body_a, body_b;
+  Vec3 normal = Vec3::UnitY();              // from A to B, world
+  int count = 0;
+  ContactPointState points[4];
+  Real friction = 0, restitution = 0;
+  Real rolling_friction = 0, torsional_friction = 0;
+  Vec3 rolling_impulse = Vec3::Zero();      // world vector, carried
+  std::int32_t rolling_row = -1;
+  bool enabled = true;                      // a callback may veto
+  bool touching = false;                    // some point within the margin this step
+  bool began = false;                       // first step touching (for events)
+
+  std::uint64_t key() const {
+    return (std::uint64_t(std::uint32_t(shape_a)) << 40) ^ (std::uint64_t(std::uint32_t(shape_b)) << 16) ^
+           std::uint64_t(std::uint32_t(triangle + 1) & 0xffff);
+  }
+  Real totalNormalImpulse() const {
+    Real s = 0;
+    for (int i = 0; i < count; ++i) s += points[i].normal_impulse;
+    return s;
+  }
+};
+
+struct ContactRowSettings {
+  Real h = Real(1) / 60;
+  Real contact_erp = Real(0.2);
+  Real cfm = 0;  // global CFM (ODE units)
+  Real slop = Real(0.005);
+  Real restitution_threshold = Real(0.2);
+  Real max_correction_velocity = Real(10);
+  Correction correction = Correction::PseudoVelocity;
+  bool warm_start = true;
+  Real warm_start_factor = 1;
+};
+
+// Appends the rows of one contact and records their (absolute) indices in
+// it; `island_begin` is the index of the island's first row.
+void buildContactRows(Contact& c, std::int32_t contact_index, const BodyView& a, const BodyView& b,
+                      const ContactRowSettings& s, std::int32_t island_begin, std::vector<ConstraintRow>& rows);
+
+// After the solve: keep the impulses for the next (sub)step.
+void storeContactImpulses(Contact& c, const std::vector<ConstraintRow>& rows);
+
+}  // namespace cairn

@@ -1,0 +1,240 @@
+// Stage 3 of the step: broadphase -> filtering -> narrowphase -> contact
+// cache (warm-start impulses matched by feature id) -> callback -> events.
+#include "collision/aabb.hpp"
+#include "dynamics/error.hpp"
+#include "world/world.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cairn {
+
+namespace {
+
+std::uint64_t bodyPairKey(BodyId a, BodyId b) {
+  const auto lo = static_cast<std::uint32_t>(std::min(a.index, b.index));
+  const auto hi = static_cast<std::uint32_t>(std::max(a.index, b.index));
+  return (std::uint64_t(lo) << 32) | hi;
+}
+
+// How far a shape's contacts must reach this step: the margin, and for a
+// continuous-collision body the distance it can travel in the step.
+Real reach(const Body& b, Real margin, Real h) {
+  return b.ccd ? margin + h * b.linear_velocity.norm() : margin;
+}
+
+}  // namespace
+
+void World::registerShapes(BodyId id) {
+  const Body& b = body(id);
+  for (size_t i = 0; i < b.shapes.size(); ++i) {
+    ShapeRef ref;
+    ref.body = id;
+    ref.index = static_cast<std::int32_t>(i);
+    const Transform t = b.transform() * b.shapes[i].local;
+    Aabb box = shapeAabb(b.shapes[i], t);
+    if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
+    ref.proxy = broadphase_.createProxy(box, static_cast<int>(shapes_.size()));
+    shapes_.push_back(ref);
+  }
+}
+
+void World::setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution) {
+  if (!std::isfinite(friction) || friction < 0) throw InputError("pair material", "friction", "must be finite and >= 0");
+  if (!std::isfinite(restitution) || restitution < 0 || restitution > 1)
+    throw InputError("pair material", "restitution", "must lie in [0, 1]");
+  const std::uint64_t key = bodyPairKey(a, b);
+  auto it = std::lower_bound(pair_materials_.begin(), pair_materials_.end(), key,
+                             [](const PairMaterial& m, std::uint64_t k) { return m.key < k; });
+  if (it != pair_materials_.end() && it->key == key) *it = {key, friction, restitution};
+  else pair_materials_.insert(it, {key, friction, restitution});
+}
+
+bool World::shouldCollide(const Body& a, const Body& b, BodyId ia, BodyId ib) const {
+  if (ia == ib) return false;
+  if (!a.isDynamic() && !b.isDynamic()) return false;  // static and kinematic never collide with each other
+  if ((a.collision_group & b.collision_mask) == 0 || (b.collision_group & a.collision_mask) == 0) return false;
+  // A pair that shares a joint does not collide unless the joint says so.
+  for (const Joint& j : joints_) {
+    if (j.broken || j.def.collide_connected) continue;
+    if ((j.def.body_a == ia && j.def.body_b == ib) || (j.def.body_a == ib && j.def.body_b == ia)) return false;
+  }
+  return true;
+}
+
+Real World::maxPenetration() const {
+  Real worst = 0;
+  for (const Contact& c : contacts_) {
+    if (!c.enabled) continue;
+    const BodyView a = view(c.body_a), b = view(c.body_b);
+    for (int i = 0; i < c.count; ++i)
+      worst = std::max(worst, -(worldPoint(b, c.points[i].local_b) - worldPoint(a, c.points[i].local_a)).dot(c.normal));
+  }
+  return worst;
+}
+
+void World::detectContacts(Real h) {
+  // 1. Broadphase: move the proxies of bodies that can move.
+  for (const ShapeRef& ref : shapes_) {
+    const Body& b = body(ref.body);
+    if (b.type == BodyType::Static || b.asleep) continue;
+    const Transform t = b.transform() * b.shapes[static_cast<size_t>(ref.index)].local;
+    const Aabb box = shapeAabb(b.shapes[static_cast<size_t>(ref.index)], t).expanded(reach(b, settings_.contact_margin, h));
+    broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
+  }
+  broadphase_.updatePairs(pairs_);
+
+  // 2. Narrowphase over the candidate pairs, matching last step's contacts.
+  std::swap(old_contacts_, contacts_);
+  contacts_.clear();
+  for (const auto& [pa, pb] : pairs_) {
+    std::int32_t sa = broadphase_.user(pa), sb = broadphase_.user(pb);
+    if (sa > sb) std::swap(sa, sb);
+    const ShapeRef& ra = shapes_[static_cast<size_t>(sa)];
+    const ShapeRef& rb = shapes_[static_cast<size_t>(sb)];
+    const Body& ba = body(ra.body);
+    const Body& bb = body(rb.body);
+    if (!shouldCollide(ba, bb, ra.body, rb.body)) continue;
+    const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
+    if (a_still && b_still && (ba.asleep || bb.asleep)) {
+      // Nothing here moves: keep the cached contacts as they were.
+      for (const Contact& c : old_contacts_)
+        if (c.shape_a == sa && c.shape_b == sb) contacts_.push_back(c);
+      continue;
+    }
+    const ShapeDesc& sda = ba.shapes[static_cast<size_t>(ra.index)];
+    const ShapeDesc& sdb = bb.shapes[static_cast<size_t>(rb.index)];
+    const Real margin = std::max(reach(ba, settings_.contact_margin, h), reach(bb, settings_.contact_margin, h));
+    manifolds_.clear();
+    collide(sda, ba.transform() * sda.local, sdb, bb.transform() * sdb.local, margin, manifolds_);
+    for (const Manifold& m : manifolds_) {
+      if (m.count == 0) continue;
+      Contact c;
+      c.shape_a = sa;
+      c.shape_b = sb;
+      c.triangle = m.triangle;
+      c.body_a = ra.body;
+      c.body_b = rb.body;
+      c.normal = m.normal;
+      c.count = m.count;
+      c.friction = std::sqrt(ba.friction * bb.friction);
+      c.restitution = std::max(ba.restitution, bb.restitution);
+      c.rolling_friction = std::max(ba.rolling_friction, bb.rolling_friction);
+      c.torsional_friction = std::max(ba.torsional_friction, bb.torsional_friction);
+      const std::uint64_t pk = bodyPairKey(ra.body, rb.body);
+      const auto mat = std::lower_bound(pair_materials_.begin(), pair_materials_.end(), pk,
+                                        [](const PairMaterial& x, std::uint64_t k) { return x.key < k; });
+      if (mat != pair_materials_.end() && mat->key == pk) {
+        c.friction = mat->friction;
+        c.restitution = mat->restitution;
+      }
+      const Transform ta = ba.transform(), tb = bb.transform();
+      for (int i = 0; i < m.count; ++i) {
+        ContactPointState& p = c.points[i];
+        const ContactPoint& q = m.points[i];
+        p.feature_id = q.feature_id;
+        p.depth = q.depth;
+        // Surface points: A's at position + n d/2, B's at position - n d/2.
+        const Vec3 on_a = q.position + m.normal * (q.depth / 2), on_b = q.position - m.normal * (q.depth / 2);
+        p.local_a = ta.applyInverse(on_a);
+        p.local_b = tb.applyInverse(on_b);
+        p.approach_speed = m.normal.dot(bb.velocityAt(on_b) - ba.velocityAt(on_a));
+      }
+      c.touching = true;
+      contacts_.push_back(c);
+    }
+  }
+  std::stable_sort(contacts_.begin(), contacts_.end(), [](const Contact& x, const Contact& y) { return x.key() < y.key(); });
+
+  // 3. Warm start: carry impulses from last step's points with the same
+  //    feature id (or, failing that, within 2 cm on body A).
+  std::sort(old_contacts_.begin(), old_contacts_.end(), [](const Contact& x, const Contact& y) { return x.key() < y.key(); });
+  for (Contact& c : contacts_) {
+    const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
+                                     [](const Contact& x, std::uint64_t k) { return x.key() < k; });
+    if (it == old_contacts_.end() || it->key() != c.key()) {
+      c.began = true;
+      continue;
+    }
+    c.began = !it->touching;
+    c.rolling_impulse = it->rolling_impulse;
+    for (int i = 0; i < c.count; ++i) {
+      ContactPointState& p = c.points[i];
+      const ContactPointState* match = nullptr;
+      for (int k = 0; k < it->count && !match; ++k)
+        if (it->points[k].feature_id == p.feature_id) match = &it->points[k];
+      for (int k = 0; k < it->count && !match; ++k)
+        if ((it->points[k].local_a - p.local_a).squaredNorm() < Real(4e-4)) match = &it->points[k];
+      if (match) {
+        p.normal_impulse = match->normal_impulse;
+        p.friction_impulse = match->friction_impulse;
+      }
+    }
+  }
+
+  // 4. The user's callback may veto or modify each contact.
+  if (contact_callback_) {
+    for (Contact& c : contacts_) {
+      ContactInfo info;
+      info.body_a = c.body_a;
+      info.body_b = c.body_b;
+      info.shape_a = c.shape_a;
+      info.shape_b = c.shape_b;
+      info.normal = c.normal;
+      info.count = c.count;
+      const Transform ta = body(c.body_a).transform();
+      int deepest = 0;
+      for (int i = 0; i < c.count; ++i) {
+        info.points[i] = ta.apply(c.points[i].local_a);
+        info.depths[i] = c.points[i].depth;
+        if (c.points[i].depth > c.points[deepest].depth) deepest = i;
+      }
+      info.relative_velocity = body(c.body_b).velocityAt(info.points[deepest]) - body(c.body_a).velocityAt(info.points[deepest]);
+      info.friction = c.friction;
+      info.restitution = c.restitution;
+      contact_callback_(info);
+      c.enabled = info.enabled;
+      c.friction = std::max(Real(0), info.friction);
+      c.restitution = std::clamp(info.restitution, Real(0), Real(1));
+    }
+  }
+}
+
+// Begin events are emitted after the solve so they carry the impulse of
+// their first step; End events name contacts that no longer touch.
+void World::emitContactEvents(const std::vector<Contact>& old) {
+  for (const Contact& c : contacts_) {
+    if (!c.began || !c.enabled) continue;
+    ContactEvent e;
+    e.type = ContactEvent::Type::Begin;
+    e.step = step_count_;
+    e.body_a = c.body_a;
+    e.body_b = c.body_b;
+    e.shape_a = c.shape_a;
+    e.shape_b = c.shape_b;
+    e.normal = c.normal;
+    int deepest = 0;
+    for (int i = 0; i < c.count; ++i)
+      if (c.points[i].depth > c.points[deepest].depth) deepest = i;
+    e.point = body(c.body_a).transform().apply(c.points[deepest].local_a);
+    e.impulse = c.totalNormalImpulse();
+    contact_events_.push_back(e);
+  }
+  for (const Contact& o : old) {
+    if (!o.touching || !o.enabled) continue;
+    const auto it = std::lower_bound(contacts_.begin(), contacts_.end(), o.key(),
+                                     [](const Contact& x, std::uint64_t k) { return x.key() < k; });
+    if (it != contacts_.end() && it->key() == o.key()) continue;
+    ContactEvent e;
+    e.type = ContactEvent::Type::End;
+    e.step = step_count_;
+    e.body_a = o.body_a;
+    e.body_b = o.body_b;
+    e.shape_a = o.shape_a;
+    e.shape_b = o.shape_b;
+    e.normal = o.normal;
+    contact_events_.push_back(e);
+  }
+}
+
+}  // namespace cairn

@@ -1,3 +1,0 @@
-file(REMOVE_RECURSE
-  "libcairn_validation.a"
-)

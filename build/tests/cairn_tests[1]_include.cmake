@@ -1,5 +1,0 @@
-if(EXISTS "/work/main/build/tests/cairn_tests[1]_tests.cmake")
-  include("/work/main/build/tests/cairn_tests[1]_tests.cmake")
-else()
-  add_test(cairn_tests_NOT_BUILT cairn_tests_NOT_BUILT)
-endif()

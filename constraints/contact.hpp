@@ -75,10 +75,16 @@ struct ContactRowSettings {
   Real warm_start_factor = 1;
 };
 
-// Appends the rows of one contact and records their (absolute) indices in
-// it; `island_begin` is the index of the island's first row.
-void buildContactRows(Contact& c, std::int32_t contact_index, const BodyView& a, const BodyView& b,
-                      const ContactRowSettings& s, std::int32_t island_begin, std::vector<ConstraintRow>& rows);
+// Appends the normal rows of one contact, then (in a later call, once every
+// normal row of the island exists) its friction and rolling rows, recording
+// their absolute indices in it; `island_begin` is the index of the island's
+// first row. Islands list all normal rows before any friction row, as ODE
+// and Bullet do: each sweep then bounds friction by this sweep's normal
+// impulses.
+void buildContactNormalRows(Contact& c, std::int32_t contact_index, const BodyView& a, const BodyView& b,
+                            const ContactRowSettings& s, std::vector<ConstraintRow>& rows);
+void buildContactFrictionRows(Contact& c, std::int32_t contact_index, const BodyView& a, const BodyView& b,
+                              const ContactRowSettings& s, std::int32_t island_begin, std::vector<ConstraintRow>& rows);
 
 // After the solve: keep the impulses for the next (sub)step.
 void storeContactImpulses(Contact& c, const std::vector<ConstraintRow>& rows);

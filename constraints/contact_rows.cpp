@@ -42,27 +42,25 @@ ConstraintRow makeAngularRow(const BodyView& a, const BodyView& b, const Vec3& u
 
 }  // namespace
 
-void buildContactRows(Contact& c, std::int32_t owner, const BodyView& a, const BodyView& b, const ContactRowSettings& s,
-                      std::int32_t island_begin, std::vector<ConstraintRow>& rows) {
+void buildContactNormalRows(Contact& c, std::int32_t owner, const BodyView& a, const BodyView& b,
+                            const ContactRowSettings& s, std::vector<ConstraintRow>& rows) {
   const Vec3& n = c.normal;
   const Real cfm = s.cfm / s.h;
   const Real warm = s.warm_start ? s.warm_start_factor : Real(0);
-  int deepest = 0;
   for (int i = 0; i < c.count; ++i) {
     ContactPointState& p = c.points[i];
     const Vec3 pa = worldPoint(a, p.local_a), pb = worldPoint(b, p.local_b);
     const Vec3 ra = pa - a.x, rb = pb - b.x;
     const Real sep = (pb - pa).dot(n);
-    if (p.depth > c.points[deepest].depth) deepest = i;
+    p.normal_row = p.friction_row = -1;
 
     ConstraintRow nr = makeRow(a, b, n, ra, rb, cfm, RowKind::ContactNormal, owner, i);
-    if (nr.inv_diag == 0) {
-      p.normal_row = p.friction_row = -1;
-      continue;
-    }
+    if (nr.inv_diag == 0) continue;
     nr.lo = 0;
     nr.hi = kInf;
     const bool bounce = c.restitution > 0 && -p.approach_speed > s.restitution_threshold;
+    // Push-out speed for the penetration beyond the slop (zero when within).
+    const Real push = sep > 0 ? 0 : std::clamp(s.contact_erp / s.h * (-sep - s.slop), Real(0), s.max_correction_velocity);
     if (sep > 0) {
       // Speculative: the gap may close this step but no more -- unless the
       // bodies meet within the step, when Newton's law applies at once.
@@ -70,43 +68,56 @@ void buildContactRows(Contact& c, std::int32_t owner, const BodyView& a, const B
       if (bounce && sep + s.h * p.approach_speed < 0) nr.rhs = -c.restitution * p.approach_speed;
     } else {
       nr.rhs = bounce ? -c.restitution * p.approach_speed : 0;
-      const Real push = std::min(s.contact_erp / s.h * (-sep - s.slop), s.max_correction_velocity);
-      if (push > 0) {
-        if (s.correction == Correction::InRhs) {
-          nr.rhs = std::max(nr.rhs, push);
-        } else {
-          nr.correction = s.correction;
-          nr.bias_rhs = push;
-        }
-      }
+    }
+    if (s.correction == Correction::InRhs) {
+      nr.rhs = std::max(nr.rhs, push);
+    } else {
+      // Every normal row of the manifold takes part in the correction pass
+      // (target 0 within the slop, -gap/h while separated), so pushing one
+      // corner out lifts the body instead of tipping it.
+      nr.correction = s.correction;
+      nr.bias_rhs = sep > 0 ? -sep / s.h : push;
     }
     nr.lambda = warm * p.normal_impulse;
     p.normal_row = static_cast<std::int32_t>(rows.size());
     rows.push_back(nr);
+  }
+}
 
-    p.friction_row = -1;
-    if (c.friction <= 0) continue;  // only what the scene needs: no rows for mu = 0
-    // Tangents: along the sliding direction when sliding, so the pyramid
-    // does not favour axes; otherwise along the carried friction impulse,
-    // else any perpendicular.
-    const Vec3 vrel = (b.v + b.w.cross(rb)) - (a.v + a.w.cross(ra));
-    Vec3 vt = vrel - n * n.dot(vrel);
-    Vec3 t1;
-    if (vt.norm() > Real(1e-3)) t1 = vt.normalized();
-    else if ((p.friction_impulse - n * n.dot(p.friction_impulse)).norm() > Real(1e-12))
-      t1 = (p.friction_impulse - n * n.dot(p.friction_impulse)).normalized();
-    else t1 = anyPerpendicular(n);
-    const Vec3 t2 = n.cross(t1);
-    p.friction_row = static_cast<std::int32_t>(rows.size());
-    for (int k = 0; k < 2; ++k) {
-      const Vec3 t = k == 0 ? t1 : t2;
-      ConstraintRow fr = makeRow(a, b, t, ra, rb, cfm, RowKind::ContactFriction, owner, 4 + 2 * i + k);
-      fr.normal_row = p.normal_row - island_begin;
-      fr.mu = c.friction;
-      fr.lo = -kInf;
-      fr.hi = kInf;
-      fr.lambda = warm * p.friction_impulse.dot(t);
-      rows.push_back(fr);
+void buildContactFrictionRows(Contact& c, std::int32_t owner, const BodyView& a, const BodyView& b,
+                              const ContactRowSettings& s, std::int32_t island_begin, std::vector<ConstraintRow>& rows) {
+  const Vec3& n = c.normal;
+  const Real cfm = s.cfm / s.h;
+  const Real warm = s.warm_start ? s.warm_start_factor : Real(0);
+  int deepest = 0;
+  for (int i = 0; i < c.count; ++i)
+    if (c.points[i].depth > c.points[deepest].depth) deepest = i;
+  if (c.friction > 0) {  // only what the scene needs: no friction rows for mu = 0
+    for (int i = 0; i < c.count; ++i) {
+      ContactPointState& p = c.points[i];
+      if (p.normal_row < 0) continue;
+      const Vec3 ra = worldPoint(a, p.local_a) - a.x;
+      const Vec3 rb = worldPoint(b, p.local_b) - b.x;
+      // Tangents: along the sliding direction when sliding, so the pyramid
+      // does not favour axes; otherwise along the carried friction impulse,
+      // else any perpendicular.
+      const Vec3 vrel = (b.v + b.w.cross(rb)) - (a.v + a.w.cross(ra));
+      const Vec3 vt = vrel - n * n.dot(vrel);
+      const Vec3 carried = p.friction_impulse - n * n.dot(p.friction_impulse);
+      Vec3 t1;
+      if (vt.norm() > Real(1e-3)) t1 = vt.normalized();
+      else if (carried.norm() > Real(1e-12)) t1 = carried.normalized();
+      else t1 = anyPerpendicular(n);
+      const Vec3 t2 = n.cross(t1);
+      p.friction_row = static_cast<std::int32_t>(rows.size());
+      for (int k = 0; k < 2; ++k) {
+        const Vec3 t = k == 0 ? t1 : t2;
+        ConstraintRow fr = makeRow(a, b, t, ra, rb, cfm, RowKind::ContactFriction, owner, 4 + 2 * i + k);
+        fr.normal_row = p.normal_row - island_begin;
+        fr.mu = c.friction;
+        fr.lambda = warm * p.friction_impulse.dot(t);
+        rows.push_back(fr);
+      }
     }
   }
 

@@ -44,6 +44,80 @@ inline Real solveRow(ConstraintRow& r, std::span<ConstraintRow> rows, std::span<
   return std::abs(d);
 }
 
+// A_ij = J_i M^-1 J_j^T for two rows on the same pair of bodies.
+inline Real coupling(const ConstraintRow& i, const ConstraintRow& j) {
+  return i.j_lin_a.dot(j.m_lin_a) + i.j_ang_a.dot(j.m_ang_a) + i.j_lin_b.dot(j.m_lin_b) + i.j_ang_b.dot(j.m_ang_b);
+}
+
+// One manifold's normal rows solved together: local projected sweeps on
+// A_b (bounds lambda >= 0) until the block settles, then one update of the
+// two bodies. Local sweeps cost a few flops each and touch no body.
+inline Real solveBlock(ConstraintRow* r, int n, const Real* a_b, std::span<SolverBody> bodies, Real sor) {
+  SolverBody& a = bodies[r[0].body_a];
+  SolverBody& b = bodies[r[0].body_b];
+  Real residual[4], lambda[4], delta[4] = {0, 0, 0, 0};
+  Real scale = 0;
+  for (int i = 0; i < n; ++i) {
+    residual[i] = r[i].rhs - rowVelocity(r[i], a, b);  // target minus J v, before this block's change
+    lambda[i] = r[i].lambda;
+    scale = std::max(scale, std::abs(lambda[i]) + std::abs(residual[i]));
+  }
+  const Real tol = Real(1e-13) * (scale + Real(1e-30));
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    Real change = 0;
+    for (int i = 0; i < n; ++i) {
+      Real jv = 0;  // A_b row i times this block's change so far
+      for (int k = 0; k < n; ++k) jv += a_b[i * n + k] * delta[k];
+      const Real d = (residual[i] - jv - r[i].cfm * lambda[i]) * r[i].inv_diag;
+      const Real next = std::max(lambda[i] + sor * d, r[i].lo);
+      const Real step = next - lambda[i];
+      lambda[i] = next;
+      delta[i] += step;
+      change = std::max(change, std::abs(step));
+    }
+    if (change <= tol) break;
+  }
+  Real max_delta = 0;
+  for (int i = 0; i < n; ++i) {
+    r[i].lambda = lambda[i];
+    applyImpulse(r[i], a, b, delta[i]);
+    max_delta = std::max(max_delta, std::abs(delta[i]));
+  }
+  return max_delta;
+}
+
+// Splits the rows into units: single rows, and blocks of 2 to 4 normal rows
+// of the same manifold (consecutive, same owner), with their A_b.
+void buildUnits(std::span<const ConstraintRow> rows, bool blocks, PgsScratch& s) {
+  s.unit_begin.clear();
+  s.block_of.clear();
+  s.block.clear();
+  for (size_t i = 0; i < rows.size();) {
+    size_t j = i + 1;
+    if (blocks && rows[i].kind == RowKind::ContactNormal)
+      while (j < rows.size() && j - i < 4 && rows[j].kind == RowKind::ContactNormal && rows[j].owner == rows[i].owner &&
+             rows[j].body_a == rows[i].body_a && rows[j].body_b == rows[i].body_b)
+        ++j;
+    s.unit_begin.push_back(static_cast<std::int32_t>(i));
+    if (j - i > 1) {
+      s.block_of.push_back(static_cast<std::int32_t>(s.block.size()));
+      for (size_t p = i; p < j; ++p)
+        for (size_t q = i; q < j; ++q) s.block.push_back(coupling(rows[p], rows[q]));
+    } else {
+      s.block_of.push_back(-1);
+    }
+    i = j;
+  }
+  s.unit_begin.push_back(static_cast<std::int32_t>(rows.size()));  // sentinel
+}
+
+inline Real solveUnit(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, const PgsScratch& s, size_t u,
+                      Real sor) {
+  const std::int32_t begin = s.unit_begin[u], end = s.unit_begin[u + 1];
+  if (s.block_of[u] < 0) return solveRow(rows[static_cast<size_t>(begin)], rows, bodies, sor);
+  return solveBlock(&rows[static_cast<size_t>(begin)], end - begin, &s.block[static_cast<size_t>(s.block_of[u])], bodies, sor);
+}
+
 }  // namespace
 
 void applyWarmStart(std::span<const ConstraintRow> rows, std::span<SolverBody> bodies) {
@@ -52,22 +126,24 @@ void applyWarmStart(std::span<const ConstraintRow> rows, std::span<SolverBody> b
 }
 
 PgsStats solvePgs(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, const PgsSettings& s,
-                  std::vector<std::int32_t>& order, std::uint64_t& rng_state) {
+                  PgsScratch& scratch, std::uint64_t& rng_state) {
   PgsStats stats;
-  const auto n = static_cast<std::int32_t>(rows.size());
-  if (n == 0) return stats;
+  if (rows.empty()) return stats;
+  buildUnits(rows, s.manifold_blocks, scratch);
+  const size_t units = scratch.block_of.size();
   if (s.randomize_order) {
-    order.resize(static_cast<size_t>(n));
-    for (std::int32_t i = 0; i < n; ++i) order[static_cast<size_t>(i)] = i;
+    scratch.order.resize(units);
+    for (size_t u = 0; u < units; ++u) scratch.order[u] = static_cast<std::int32_t>(u);
   }
   for (int it = 0; it < s.iterations; ++it) {
     Real max_delta = 0;
     if (s.randomize_order) {
-      for (std::int32_t i = n - 1; i > 0; --i)  // Fisher-Yates
-        std::swap(order[static_cast<size_t>(i)], order[nextRandom(rng_state) % static_cast<std::uint64_t>(i + 1)]);
-      for (std::int32_t i : order) max_delta = std::max(max_delta, solveRow(rows[static_cast<size_t>(i)], rows, bodies, s.sor));
+      for (size_t i = units - 1; i > 0; --i)  // Fisher-Yates
+        std::swap(scratch.order[i], scratch.order[nextRandom(rng_state) % (i + 1)]);
+      for (std::int32_t u : scratch.order)
+        max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, static_cast<size_t>(u), s.sor));
     } else {
-      for (ConstraintRow& r : rows) max_delta = std::max(max_delta, solveRow(r, rows, bodies, s.sor));
+      for (size_t u = 0; u < units; ++u) max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, u, s.sor));
     }
     stats.iterations = it + 1;
     stats.last_max_delta = max_delta;
@@ -79,7 +155,10 @@ PgsStats solvePgs(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, c
 bool solvePgsCorrection(std::span<const ConstraintRow> rows, std::span<SolverBody> bodies, Correction which,
                         const PgsSettings& s, std::vector<Real>& lambda) {
   bool any = false;
-  for (const ConstraintRow& r : rows) any = any || (r.correction == which && r.bias_rhs != 0);
+  // Something to correct: a push (bias > 0), or a pull on a row that can
+  // pull (lo < 0). A negative bias on a one-sided row only permits approach.
+  for (const ConstraintRow& r : rows)
+    any = any || (r.correction == which && (r.bias_rhs > 0 || (r.bias_rhs < 0 && r.lo < 0)));
   if (!any) return false;
   lambda.assign(rows.size(), 0);
   for (int it = 0; it < s.iterations; ++it) {
@@ -102,8 +181,6 @@ bool solvePgsCorrection(std::span<const ConstraintRow> rows, std::span<SolverBod
 }
 
 Real pgsResidual(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {
-  // Natural map F_i = lambda_i - clamp(lambda_i - w_i, lo_i, hi_i) with
-  // w_i = J_i v - rhs_i + cfm_i lambda_i; zero exactly at an LCP solution.
   Real res = 0;
   for (const ConstraintRow& r : rows) {
     Real lo = r.lo, hi = r.hi;

@@ -9,6 +9,7 @@
 #include "constraints/joint.hpp"
 #include "constraints/row.hpp"
 #include "dynamics/body.hpp"
+#include "solver/pgs.hpp"
 #include "solver/solver_body.hpp"
 #include "world/defs.hpp"
 #include "world/settings.hpp"
@@ -217,7 +218,7 @@ class World {
   std::vector<SolverBody> solver_bodies_;
   std::vector<SolverBody> pseudo_bodies_;  // split-impulse pseudo-velocities (index as solver bodies)
   std::vector<Real> pseudo_lambda_;
-  std::vector<std::int32_t> order_scratch_;
+  PgsScratch pgs_scratch_;
   std::uint64_t rng_state_ = 0;
   bool rng_seeded_ = false;
 

@@ -133,10 +133,16 @@ void World::buildRows(Real h) {
       ctx.correction = settings_.position_correction;
       buildJointRows(j, view(j.def.body_a), view(j.def.body_b), ctx, jrs);
     }
-    for (std::int32_t k = contact_start[static_cast<size_t>(isl)]; k < contact_start[static_cast<size_t>(isl) + 1]; ++k) {
+    const std::int32_t c0 = contact_start[static_cast<size_t>(isl)], c1 = contact_start[static_cast<size_t>(isl) + 1];
+    for (std::int32_t k = c0; k < c1; ++k) {
       const auto i = static_cast<size_t>(contact_order[static_cast<size_t>(k)]);
       Contact& c = contacts_[i];
-      buildContactRows(c, static_cast<std::int32_t>(i), view(c.body_a), view(c.body_b), crs, begin, rows_);
+      buildContactNormalRows(c, static_cast<std::int32_t>(i), view(c.body_a), view(c.body_b), crs, rows_);
+    }
+    for (std::int32_t k = c0; k < c1; ++k) {
+      const auto i = static_cast<size_t>(contact_order[static_cast<size_t>(k)]);
+      Contact& c = contacts_[i];
+      buildContactFrictionRows(c, static_cast<std::int32_t>(i), view(c.body_a), view(c.body_b), crs, begin, rows_);
     }
     island_rows_.emplace_back(begin, static_cast<std::int32_t>(rows_.size()));
   }
@@ -163,7 +169,7 @@ void World::solveRows() {
   for (const auto& [begin, end] : island_rows_) {
     std::span<ConstraintRow> rows = all.subspan(static_cast<size_t>(begin), static_cast<size_t>(end - begin));
     applyWarmStart(rows, solver_bodies_);
-    const PgsStats st = solvePgs(rows, solver_bodies_, ps, order_scratch_, rng_state_);
+    const PgsStats st = solvePgs(rows, solver_bodies_, ps, pgs_scratch_, rng_state_);
     stats_.iterations = std::max(stats_.iterations, st.iterations);
     residual = std::max(residual, pgsResidual(rows, solver_bodies_));
   }

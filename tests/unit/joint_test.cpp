@@ -19,6 +19,7 @@ World hangingChain(int n, int iterations) {
   World w;
   SolverSettings s;
   s.iterations = iterations;
+  s.sleeping = false;  // these tests watch the solver on a chain at rest
   w.setSettings(s);
   for (int k = 0; k < n; ++k) {
     const BodyId id = w.createBody(test::boxDef("l" + std::to_string(k), Vec3(0, -0.25 - 0.5 * k, 0), 1, Vec3(0.05, 0.25, 0.05)));

@@ -1,0 +1,48 @@
+// A convex shape against a static triangle mesh: each triangle whose box
+// overlaps the shape's (grown by the margin) is a thin convex polygon and
+// goes through the general convex path (collide_convex.cpp), giving one
+// manifold per touching triangle, tagged with the triangle's index.
+//
+// The shape's box is computed in the mesh's frame, so the mesh's triangles
+// are tested without transforming them; only the candidates are moved to
+// world space. Triangles are two-sided (a body pushed through a triangle is
+// pushed out of whichever side is nearer), and neighbouring triangles are
+// not consulted, so a box sliding across a flat mesh can catch on an
+// internal edge (see docs/collision.md).
+//
+// Feature ids are mixed with the triangle index (a fixed odd multiplier), so
+// ids stay unique across the pair's manifolds and stable over time.
+#include "collision/aabb.hpp"
+#include "collision/narrowphase.hpp"
+
+namespace cairn::narrow {
+
+int meshConvex(const ShapeDesc& mesh, const Transform& tm, const ShapeDesc& b, const Transform& tb, Real margin, Out& out) {
+  if (!mesh.mesh || (b.type == ShapeType::ConvexHull && !b.hull)) return 0;
+  const TriangleMeshData& md = *mesh.mesh;
+  const Transform local{tm.applyInverse(tb.p), (tm.q.conjugate() * tb.q).normalized()};
+  const Aabb box = shapeAabb(b, local).expanded(margin);
+  const ConvexProxy pb = makeProxy(b, tb);
+  int added = 0;
+  for (int t = 0; t < static_cast<int>(md.triangles.size()); ++t) {
+    const auto& tri = md.triangles[t];
+    const Vec3& v0 = md.vertices[tri[0]];
+    const Vec3& v1 = md.vertices[tri[1]];
+    const Vec3& v2 = md.vertices[tri[2]];
+    if (!triangleAabb(v0, v1, v2).overlaps(box)) continue;
+    const Vec3 w0 = tm.apply(v0), w1 = tm.apply(v1), w2 = tm.apply(v2);
+    const Vec3 e = (w1 - w0).cross(w2 - w0);
+    const Real size2 = std::max({(w1 - w0).squaredNorm(), (w2 - w0).squaredNorm(), (w2 - w1).squaredNorm()});
+    if (!(e.norm() > Real(1e-12) * size2)) continue;  // no area, no normal
+    Manifold m;
+    if (!convexProxies(makeTriangleProxy(w0, w1, w2), pb, margin, m)) continue;
+    m.triangle = t;
+    const std::uint32_t salt = static_cast<std::uint32_t>(t) * 2654435761u;
+    for (int k = 0; k < m.count; ++k) m.points[k].feature_id ^= salt;
+    out.push_back(m);
+    ++added;
+  }
+  return added;
+}
+
+}  // namespace cairn::narrow

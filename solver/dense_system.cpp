@@ -1,0 +1,154 @@
+#include "solver/dense_system.hpp"
+
+#include <algorithm>
+#include <cstddef>
+
+namespace cairn {
+
+namespace {
+
+// One row side that moves a body: which row (position in the assembled
+// matrix) and which side, so its J and M^-1 J^T blocks can be read back.
+struct SideRef {
+  int pos;
+  const ConstraintRow* row;
+  bool side_b;
+};
+
+const Vec3& jLin(const SideRef& s) { return s.side_b ? s.row->j_lin_b : s.row->j_lin_a; }
+const Vec3& jAng(const SideRef& s) { return s.side_b ? s.row->j_ang_b : s.row->j_ang_a; }
+const Vec3& mLin(const SideRef& s) { return s.side_b ? s.row->m_lin_b : s.row->m_lin_a; }
+const Vec3& mAng(const SideRef& s) { return s.side_b ? s.row->m_ang_b : s.row->m_ang_a; }
+
+Real sideProduct(const SideRef& i, const SideRef& j) { return jLin(i).dot(mLin(j)) + jAng(i).dot(mAng(j)); }
+
+// Builds A[S, S] where pos_of_row[r] is row r's position in S or -1.
+Eigen::SparseMatrix<double> assembleSparse(std::span<const ConstraintRow> rows, const std::vector<int>& pos_of_row,
+                                           int n, CfmOnDiagonal cfm) {
+  // Bucket the moving sides by body (counting sort: one pass to count, one
+  // to place), so that only rows sharing a body are ever paired.
+  std::int32_t max_body = 0;
+  for (const ConstraintRow& r : rows) max_body = std::max({max_body, r.body_a, r.body_b});
+  std::vector<int> start(static_cast<std::size_t>(max_body) + 2, 0);
+  auto forEachSide = [&](auto&& f) {
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const int pos = pos_of_row[r];
+      if (pos < 0) continue;
+      const ConstraintRow& row = rows[r];
+      if (const std::int32_t k = couplingBodyA(row); k != 0) f(k, SideRef{pos, &row, false});
+      if (const std::int32_t k = couplingBodyB(row); k != 0) f(k, SideRef{pos, &row, true});
+    }
+  };
+  forEachSide([&](std::int32_t k, const SideRef&) { ++start[static_cast<std::size_t>(k) + 1]; });
+  for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+  std::vector<SideRef> sides(static_cast<std::size_t>(start.back()));
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  forEachSide([&](std::int32_t k, const SideRef& s) { sides[static_cast<std::size_t>(fill[static_cast<std::size_t>(k)]++)] = s; });
+
+  std::vector<Eigen::Triplet<double>> triplets;
+  std::size_t count = static_cast<std::size_t>(n);
+  for (std::size_t k = 0; k + 1 < start.size(); ++k) {
+    const auto deg = static_cast<std::size_t>(start[k + 1] - start[k]);
+    count += deg * deg;
+  }
+  triplets.reserve(count);
+
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const int pos = pos_of_row[r];
+    if (pos >= 0) triplets.emplace_back(pos, pos, cfm == CfmOnDiagonal::Include ? rows[r].cfm : 0.0);
+  }
+  for (std::size_t k = 0; k + 1 < start.size(); ++k) {
+    const int begin = start[k], end = start[k + 1];
+    for (int p = begin; p < end; ++p) {
+      const SideRef& sp = sides[static_cast<std::size_t>(p)];
+      triplets.emplace_back(sp.pos, sp.pos, sideProduct(sp, sp));
+      for (int q = p + 1; q < end; ++q) {
+        const SideRef& sq = sides[static_cast<std::size_t>(q)];
+        if (sp.pos == sq.pos) {
+          // Both sides of one row on the same body: the cross terms of
+          // (J_a + J_b) M^-1 (J_a + J_b)^T.
+          triplets.emplace_back(sp.pos, sp.pos, sideProduct(sp, sq) + sideProduct(sq, sp));
+        } else {
+          // One value for both triangles keeps A exactly symmetric.
+          const double v = sideProduct(sp, sq);
+          triplets.emplace_back(sp.pos, sq.pos, v);
+          triplets.emplace_back(sq.pos, sp.pos, v);
+        }
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> a(n, n);
+  a.setFromTriplets(triplets.begin(), triplets.end());  // sums duplicates, keeps explicit zeros
+  a.makeCompressed();
+  return a;
+}
+
+}  // namespace
+
+Real rowCoupling(const ConstraintRow& ri, const ConstraintRow& rj) {
+  const std::int32_t bi[2] = {couplingBodyA(ri), couplingBodyB(ri)};
+  const std::int32_t bj[2] = {couplingBodyA(rj), couplingBodyB(rj)};
+  Real s = 0;
+  for (int p = 0; p < 2; ++p) {
+    if (bi[p] == 0) continue;
+    const SideRef si{0, &ri, p == 1};
+    for (int q = 0; q < 2; ++q) {
+      if (bj[q] != bi[p]) continue;
+      s += sideProduct(si, SideRef{0, &rj, q == 1});
+    }
+  }
+  return s;
+}
+
+Eigen::MatrixXd assembleDenseA(std::span<const ConstraintRow> rows, CfmOnDiagonal cfm) {
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd a(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const ConstraintRow& ri = rows[static_cast<std::size_t>(i)];
+    for (Eigen::Index j = 0; j <= i; ++j) {
+      a(i, j) = a(j, i) = rowCoupling(ri, rows[static_cast<std::size_t>(j)]);
+    }
+    if (cfm == CfmOnDiagonal::Include) a(i, i) += ri.cfm;
+  }
+  return a;
+}
+
+Eigen::VectorXd assembleB(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {
+  Eigen::VectorXd b(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) b(static_cast<Eigen::Index>(i)) = rowJv(rows[i], bodies) - rows[i].rhs;
+  return b;
+}
+
+Eigen::SparseMatrix<double> assembleSparseA(std::span<const ConstraintRow> rows, CfmOnDiagonal cfm) {
+  std::vector<int> pos(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) pos[i] = static_cast<int>(i);
+  return assembleSparse(rows, pos, static_cast<int>(rows.size()), cfm);
+}
+
+Eigen::SparseMatrix<double> assembleSparseA(std::span<const ConstraintRow> rows, std::span<const int> subset,
+                                           CfmOnDiagonal cfm) {
+  std::vector<int> pos(rows.size(), -1);
+  for (std::size_t k = 0; k < subset.size(); ++k) pos[static_cast<std::size_t>(subset[k])] = static_cast<int>(k);
+  return assembleSparse(rows, pos, static_cast<int>(subset.size()), cfm);
+}
+
+DenseLcp assembleDenseLcp(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {
+  DenseLcp lcp;
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  lcp.A = assembleDenseA(rows, CfmOnDiagonal::Include);
+  lcp.b = assembleB(rows, bodies);
+  lcp.lo.resize(n);
+  lcp.hi.resize(n);
+  lcp.mu.resize(n);
+  lcp.normal_row.resize(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    lcp.lo(k) = rows[i].lo;
+    lcp.hi(k) = rows[i].hi;
+    lcp.mu(k) = rows[i].mu;
+    lcp.normal_row[i] = rows[i].normal_row;
+  }
+  return lcp;
+}
+
+}  // namespace cairn

@@ -1,0 +1,207 @@
+#include "solver/direct_solver.hpp"
+
+#include "solver/dense_system.hpp"
+#include "solver/lcp_residual.hpp"
+
+#include <Eigen/CholmodSupport>
+
+#include <algorithm>
+#include <cmath>
+
+namespace cairn {
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+// A factor whose smallest-to-largest pivot ratio is below this is treated
+// as singular. CHOLMOD only reports "not positive definite" for a pivot
+// <= 0; a linearly dependent row whose pivot round-off left at +1e-17
+// would otherwise be solved with a 1e16 gain. Genuine pivots of joint
+// systems stay many orders above this.
+constexpr double kSingularPivotRatio = 1e-12;
+
+bool isBilateral(const ConstraintRow& r, std::size_t i, std::size_t n) {
+  const bool friction = r.normal_row >= 0 && static_cast<std::size_t>(r.normal_row) < n &&
+                        static_cast<std::size_t>(r.normal_row) != i;
+  return !friction && r.lo == -kInf && r.hi == kInf;
+}
+
+
+// FNV-1a over the structure key (its size included).
+std::uint64_t hashKey(const std::vector<std::int32_t>& key) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  auto mix = [&h](std::uint64_t v) {
+    for (int k = 0; k < 8; ++k) {
+      h ^= (v >> (8 * k)) & 0xff;
+      h *= 0x100000001b3ull;
+    }
+  };
+  mix(key.size());
+  for (std::int32_t v : key) mix(static_cast<std::uint64_t>(static_cast<std::uint32_t>(v)));
+  return h;
+}
+
+// Exposes CHOLMOD's pivot-ratio estimate, which Eigen's wrapper keeps
+// behind its protected factor pointer.
+class CholmodFactor : public Eigen::CholmodDecomposition<SpMat, Eigen::Lower> {
+ public:
+  CholmodFactor() { this->cholmod().print = 0; }  // report through info(), not stderr
+  // min/max of diag(L) (squared for LL^T), or |D| for LDL^T; 0 if singular.
+  double pivotRatio() {
+    return this->m_cholmodFactor != nullptr ? cholmod_rcond(this->m_cholmodFactor, &this->cholmod()) : 0.0;
+  }
+};
+
+}  // namespace
+
+struct DirectSolver::Impl {
+  CholmodFactor factor;
+  bool analysed = false;
+  std::vector<std::int32_t> key;  // coupling bodies of the bilateral rows, in order
+  std::uint64_t hash = 0;
+  int analysis_count = 0;
+  // Scratch kept between calls so a steady scene does not allocate.
+  std::vector<int> bilateral, unilateral;
+  std::vector<Real> diag;
+  Eigen::VectorXd rhs, delta;
+};
+
+DirectSolver::DirectSolver() : impl_(std::make_unique<Impl>()) {}
+DirectSolver::~DirectSolver() = default;
+DirectSolver::DirectSolver(DirectSolver&&) noexcept = default;
+DirectSolver& DirectSolver::operator=(DirectSolver&&) noexcept = default;
+
+int DirectSolver::analysisCount() const { return impl_->analysis_count; }
+std::uint64_t DirectSolver::structureHash() const { return impl_->hash; }
+void DirectSolver::reset() {
+  impl_->analysed = false;
+  impl_->key.clear();
+  impl_->hash = 0;
+}
+
+DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<SolverBody> bodies,
+                                     const DirectSolverOptions& opt) {
+  Impl& s = *impl_;
+  DirectSolveStats st;
+  const std::size_t n = rows.size();
+
+  // Starting impulse, and v = v* + M^-1 J^T lambda from here on.
+  for (ConstraintRow& r : rows) {
+    const bool applied = opt.velocities_include_lambda;
+    const Real start = opt.warm_start && std::isfinite(r.lambda) ? r.lambda : Real(0);
+    const Real already = applied && std::isfinite(r.lambda) ? r.lambda : Real(0);
+    applyRowImpulse(r, start - already, bodies);
+    r.lambda = start;
+  }
+
+  // Partition. Inert rows keep lambda = clamp(0, lo, hi) and no velocity.
+  s.bilateral.clear();
+  s.unilateral.clear();
+  s.diag.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    ConstraintRow& r = rows[i];
+    s.diag[i] = rowCoupling(r, r) + r.cfm;
+    if (!(s.diag[i] > 0)) {
+      // Inert: moves no body and has no cfm, so no lambda changes its w.
+      const Real pinned = r.normal_row >= 0 ? Real(0) : std::clamp(Real(0), r.lo, std::max(r.lo, r.hi));
+      applyRowImpulse(r, pinned - r.lambda, bodies);  // a no-op unless the row's blocks are inconsistent
+      r.lambda = pinned;
+      ++st.inert_rows;
+      continue;
+    }
+    (isBilateral(r, i, n) ? s.bilateral : s.unilateral).push_back(static_cast<int>(i));
+  }
+  st.bilateral_rows = static_cast<int>(s.bilateral.size());
+  st.unilateral_rows = static_cast<int>(s.unilateral.size());
+
+  // Factor A_BB, reusing the symbolic analysis when the pattern is unchanged.
+  bool have_factor = false;
+  if (!s.bilateral.empty()) {
+    const SpMat abb = assembleSparseA(rows, s.bilateral, CfmOnDiagonal::Include);
+    std::vector<std::int32_t> key;
+    key.reserve(2 * s.bilateral.size());
+    for (int i : s.bilateral) {
+      key.push_back(couplingBodyA(rows[static_cast<std::size_t>(i)]));
+      key.push_back(couplingBodyB(rows[static_cast<std::size_t>(i)]));
+    }
+    const std::uint64_t hash = hashKey(key);
+    if (!s.analysed || hash != s.hash || key != s.key) {
+      s.factor.analyzePattern(abb);
+      s.analysed = true;
+      s.key = std::move(key);
+      s.hash = hash;
+      ++s.analysis_count;
+      st.analysed = true;
+    }
+    st.structure_hash = s.hash;
+
+    s.factor.setShift(0);
+    s.factor.factorize(abb);
+    ++st.factorizations;
+    have_factor = s.factor.info() == Eigen::Success && s.factor.pivotRatio() > kSingularPivotRatio;
+    if (!have_factor) {
+      Real max_diag = 0;
+      for (int i : s.bilateral) max_diag = std::max(max_diag, s.diag[static_cast<std::size_t>(i)]);
+      st.regularized = true;
+      st.regularization = opt.regularization * (max_diag > 0 ? max_diag : Real(1));
+      s.factor.setShift(st.regularization);
+      s.factor.factorize(abb);
+      ++st.factorizations;
+      have_factor = s.factor.info() == Eigen::Success && s.factor.pivotRatio() > 0;
+      st.factorization_failed = !have_factor;
+    }
+  }
+
+  // (A_BB + C_B) delta = -w_B: the bilateral rows exactly, the others fixed.
+  const auto nb = static_cast<Eigen::Index>(s.bilateral.size());
+  auto solveBilateral = [&] {
+    if (!have_factor) return;
+    s.rhs.resize(nb);
+    for (Eigen::Index p = 0; p < nb; ++p) {
+      const ConstraintRow& r = rows[static_cast<std::size_t>(s.bilateral[static_cast<std::size_t>(p)])];
+      s.rhs(p) = -(rowJv(r, bodies) - r.rhs + r.cfm * r.lambda);
+    }
+    s.delta = s.factor.solve(s.rhs);
+    if (s.factor.info() != Eigen::Success || !s.delta.allFinite()) {
+      st.factorization_failed = true;
+      have_factor = false;
+      return;
+    }
+    for (Eigen::Index p = 0; p < nb; ++p) {
+      ConstraintRow& r = rows[static_cast<std::size_t>(s.bilateral[static_cast<std::size_t>(p)])];
+      r.lambda += s.delta(p);
+      applyRowImpulse(r, s.delta(p), bodies);
+    }
+  };
+
+  const int outer = std::max(1, opt.outer_iterations);
+  for (int k = 0; k < outer; ++k) {
+    // 1. Bilateral rows exactly, the others fixed.
+    solveBilateral();
+    // 2. PGS on the unilateral rows, the bilateral ones fixed.
+    for (int sweep = 0; sweep < opt.inner_pgs_iterations; ++sweep) {
+      for (int i : s.unilateral) {
+        ConstraintRow& r = rows[static_cast<std::size_t>(i)];
+        const auto [lo, hi] = lcpRowBounds(rows, static_cast<std::size_t>(i));
+        const Real w = rowJv(r, bodies) - r.rhs + r.cfm * r.lambda;
+        const Real next = std::min(std::max(r.lambda - w / s.diag[static_cast<std::size_t>(i)], lo), hi);
+        applyRowImpulse(r, next - r.lambda, bodies);
+        r.lambda = next;
+      }
+    }
+    ++st.outer_iterations;
+    st.residual_history.push_back(lcpResidual(rows, bodies, ResidualNorm::Max));
+    // Without unilateral rows one solve is exact, unless the shift made it
+    // a proximal step that further solves refine.
+    if (s.unilateral.empty() && !st.regularized) break;
+  }
+  // Finish on the bilateral rows, so joints hold exactly for the final
+  // unilateral impulses (those keep the last PGS sweep's accuracy).
+  if (!s.unilateral.empty()) solveBilateral();
+  st.analysis_count = s.analysis_count;
+  st.residual = lcpResidual(rows, bodies, ResidualNorm::Max);
+  return st;
+}
+
+}  // namespace cairn

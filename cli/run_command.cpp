@@ -36,9 +36,16 @@ struct RunFigures {
   int rows_max = 0;
   int rows_by_kind_max[kRowKindCount] = {};
   std::vector<std::string> broken;
+  int contacts_max = 0, islands_max = 0, contacts_final = 0;
+  Real penetration_last_second = 0;
+  Real last_second_from = 0;  // time at which the last second of the run starts
 
   void record(const World& w) {
     const StepStats& st = w.lastStepStats();
+    contacts_max = std::max(contacts_max, st.contacts);
+    contacts_final = st.contacts;
+    islands_max = std::max(islands_max, st.islands);
+    if (w.time() >= last_second_from - 1e-12) penetration_last_second = std::max(penetration_last_second, st.max_penetration);
     iterations += st.iterations;
     residual_final = st.residual;
     residual_max = std::max(residual_max, st.residual);
@@ -67,6 +74,10 @@ struct RunFigures {
     m["joint_error_linear_max_m"] = joint_linear_max;
     m["joint_error_angular_max_rad"] = joint_angular_max;
     m["joints_broken"] = broken;
+    m["contacts_max"] = contacts_max;
+    m["contacts_final"] = contacts_final;
+    m["islands_max"] = islands_max;
+    m["penetration_last_second_max_m"] = penetration_last_second;
   }
 };
 
@@ -137,6 +148,7 @@ int runScene(const RunOptions& opt) {
   }
   const Real e0 = world.kineticEnergy() + world.potentialEnergy();
   RunFigures fig;
+  fig.last_second_from = scene.steps * scene.dt - 1;
   const auto t0 = std::chrono::steady_clock::now();
   int status = 0;
   for (int s = 1; s <= scene.steps; ++s) {

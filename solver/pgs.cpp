@@ -180,18 +180,4 @@ bool solvePgsCorrection(std::span<const ConstraintRow> rows, std::span<SolverBod
   return true;
 }
 
-Real pgsResidual(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {
-  Real res = 0;
-  for (const ConstraintRow& r : rows) {
-    Real lo = r.lo, hi = r.hi;
-    if (r.normal_row >= 0) {
-      hi = r.mu * rows[static_cast<size_t>(r.normal_row)].lambda;
-      lo = -hi;
-    }
-    const Real w = rowVelocity(r, bodies[r.body_a], bodies[r.body_b]) - r.rhs + r.cfm * r.lambda;
-    res = std::max(res, std::abs(r.lambda - std::clamp(r.lambda - w, lo, hi)));
-  }
-  return res;
-}
-
 }  // namespace cairn

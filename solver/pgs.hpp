@@ -68,9 +68,6 @@ PgsStats solvePgs(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, c
 bool solvePgsCorrection(std::span<const ConstraintRow> rows, std::span<SolverBody> bodies, Correction which,
                         const PgsSettings& s, std::vector<Real>& lambda);
 
-// Natural-map residual of the mixed LCP at the current impulses and
-// velocities: max_i |lambda_i - clamp(lambda_i - w_i, lo_i, hi_i)| with
-// w_i = J_i v - rhs_i + cfm_i lambda_i; zero exactly at an LCP solution.
-Real pgsResidual(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies);
+// The residual is solver/lcp_residual.hpp's lcpResidual.
 
 }  // namespace cairn

@@ -9,6 +9,7 @@
 #include "constraints/joint.hpp"
 #include "constraints/row.hpp"
 #include "dynamics/body.hpp"
+#include "solver/direct_solver.hpp"
 #include "solver/pgs.hpp"
 #include "solver/solver_body.hpp"
 #include "world/defs.hpp"
@@ -219,6 +220,7 @@ class World {
   std::vector<SolverBody> pseudo_bodies_;  // split-impulse pseudo-velocities (index as solver bodies)
   std::vector<Real> pseudo_lambda_;
   PgsScratch pgs_scratch_;
+  DirectSolver direct_solver_;  // keeps CHOLMOD's symbolic analysis while the structure holds
   std::uint64_t rng_state_ = 0;
   bool rng_seeded_ = false;
 

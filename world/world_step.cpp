@@ -19,6 +19,8 @@
 #include "dynamics/error.hpp"
 #include "dynamics/forces.hpp"
 #include "dynamics/integrate.hpp"
+#include "solver/lcp_exact.hpp"
+#include "solver/lcp_residual.hpp"
 #include "solver/pgs.hpp"
 #include "world/world.hpp"
 
@@ -130,7 +132,9 @@ void World::buildRows(Real h) {
       ctx.rows = &rows_;
       ctx.warm = settings_.warm_start ? &j.warm : nullptr;
       ctx.warm_factor = settings_.warm_start_factor;
-      ctx.correction = settings_.position_correction;
+      // The direct and exact solvers solve the ERP target with the rest in
+      // one exact solve: nothing is left for a correction pass to fix.
+      ctx.correction = settings_.method == SolverMethod::PGS ? settings_.position_correction : Correction::InRhs;
       buildJointRows(j, view(j.def.body_a), view(j.def.body_b), ctx, jrs);
     }
     const std::int32_t c0 = contact_start[static_cast<size_t>(isl)], c1 = contact_start[static_cast<size_t>(isl) + 1];
@@ -168,10 +172,31 @@ void World::solveRows() {
   Real residual = 0;
   for (const auto& [begin, end] : island_rows_) {
     std::span<ConstraintRow> rows = all.subspan(static_cast<size_t>(begin), static_cast<size_t>(end - begin));
-    applyWarmStart(rows, solver_bodies_);
-    const PgsStats st = solvePgs(rows, solver_bodies_, ps, pgs_scratch_, rng_state_);
-    stats_.iterations = std::max(stats_.iterations, st.iterations);
-    residual = std::max(residual, pgsResidual(rows, solver_bodies_));
+    switch (settings_.method) {
+      case SolverMethod::PGS: {
+        applyWarmStart(rows, solver_bodies_);
+        const PgsStats st = solvePgs(rows, solver_bodies_, ps, pgs_scratch_, rng_state_);
+        stats_.iterations = std::max(stats_.iterations, st.iterations);
+        break;
+      }
+      case SolverMethod::Direct: {
+        // CHOLMOD for the bilateral rows, PGS sweeps for the bounded ones,
+        // alternated (solver/direct_solver.hpp); warm-started from lambda.
+        DirectSolverOptions o;
+        o.inner_pgs_iterations = settings_.iterations;
+        o.warm_start = settings_.warm_start;
+        const DirectSolveStats st = direct_solver_.solve(rows, solver_bodies_, o);
+        stats_.iterations = std::max(stats_.iterations, st.outer_iterations);
+        break;
+      }
+      case SolverMethod::LCP: {
+        // Dantzig pivoting to the exact mixed-LCP solution (small scenes).
+        const ExactLcpResult st = solveLcpExact(rows, solver_bodies_);
+        stats_.iterations = std::max(stats_.iterations, st.pivots);
+        break;
+      }
+    }
+    residual = std::max(residual, lcpResidual(rows, solver_bodies_));
   }
   stats_.residual = residual;
   // Position correction in its own passes (constraints/row.hpp, Correction):

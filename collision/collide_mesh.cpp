@@ -4,8 +4,8 @@
 // manifold per touching triangle, tagged with the triangle's index.
 //
 // The shape's box is computed in the mesh's frame, so the mesh's triangles
-// are tested without transforming them; only the candidates are moved to
-// world space. Triangles are two-sided (a body pushed through a triangle is
+// are tested without transforming them (through the mesh's BVH when it has
+// one, mesh_bvh.hpp); only the candidates are moved to world space. Triangles are two-sided (a body pushed through a triangle is
 // pushed out of whichever side is nearer), and neighbouring triangles are
 // not consulted, so a box sliding across a flat mesh can catch on an
 // internal edge (see docs/collision.md).
@@ -13,7 +13,10 @@
 // Feature ids are mixed with the triangle index (a fixed odd multiplier), so
 // ids stay unique across the pair's manifolds and stable over time.
 #include "collision/aabb.hpp"
+#include "collision/mesh_bvh.hpp"
 #include "collision/narrowphase.hpp"
+
+#include <algorithm>
 
 namespace cairn::narrow {
 
@@ -23,14 +26,16 @@ int meshConvex(const ShapeDesc& mesh, const Transform& tm, const ShapeDesc& b, c
   const Transform local{tm.applyInverse(tb.p), (tm.q.conjugate() * tb.q).normalized()};
   const Aabb box = shapeAabb(b, local).expanded(margin);
   const ConvexProxy pb = makeProxy(b, tb);
+  // Candidates in triangle order, so the manifolds come out in the same
+  // order whether or not the mesh has a tree.
+  thread_local std::vector<int> candidates;
+  candidates.clear();
+  queryMeshTriangles(md, box, [&](int t) { candidates.push_back(t); });
+  std::sort(candidates.begin(), candidates.end());
   int added = 0;
-  for (int t = 0; t < static_cast<int>(md.triangles.size()); ++t) {
+  for (const int t : candidates) {
     const auto& tri = md.triangles[t];
-    const Vec3& v0 = md.vertices[tri[0]];
-    const Vec3& v1 = md.vertices[tri[1]];
-    const Vec3& v2 = md.vertices[tri[2]];
-    if (!triangleAabb(v0, v1, v2).overlaps(box)) continue;
-    const Vec3 w0 = tm.apply(v0), w1 = tm.apply(v1), w2 = tm.apply(v2);
+    const Vec3 w0 = tm.apply(md.vertices[tri[0]]), w1 = tm.apply(md.vertices[tri[1]]), w2 = tm.apply(md.vertices[tri[2]]);
     const Vec3 e = (w1 - w0).cross(w2 - w0);
     const Real size2 = std::max({(w1 - w0).squaredNorm(), (w2 - w0).squaredNorm(), (w2 - w1).squaredNorm()});
     if (!(e.norm() > Real(1e-12) * size2)) continue;  // no area, no normal

@@ -35,9 +35,14 @@ int planeConvex(const ShapeDesc& plane, const Transform& tp, const ShapeDesc& b,
   Vec3 cand[kMaxCandidates];
   std::uint32_t cand_id[kMaxCandidates];
   int nc = 0;
-  std::vector<Vec3> hull_pos;  // hulls can have many vertices
-  std::vector<Real> hull_depth;
-  std::vector<std::uint32_t> hull_id;
+  // Hulls can have any number of vertices within the margin: reused
+  // per-thread buffers keep this allocation-free after the first calls.
+  thread_local std::vector<Vec3> hull_pos;
+  thread_local std::vector<Real> hull_depth;
+  thread_local std::vector<std::uint32_t> hull_id;
+  hull_pos.clear();
+  hull_depth.clear();
+  hull_id.clear();
 
   switch (b.type) {
     case ShapeType::Sphere:

@@ -236,6 +236,10 @@ bool buildManifold(const ConvexProxy& a, const ConvexProxy& b, const Vec3& n, Re
           m.points[count++] = ContactPoint{Real(0.5) * (sa + sb), -sep, pointFeatureId(fa.index, fb.index) | (t == t0 ? 0u : 0x20000000u)};
         }
         if (count > 0) {
+          Real best = -kInf;
+          for (int k = 0; k < count; ++k) best = std::max(best, m.points[k].depth);
+          if (best < depth - Real(1e-9) * (1 + std::abs(depth)))
+            m.points[count++] = ContactPoint{Real(0.5) * (wa + wb), depth, pointFeatureId(fa.index, fb.index)};
           m.normal = n;
           m.count = count;
           return true;

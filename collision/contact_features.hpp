@@ -13,7 +13,7 @@
 //             else the side line through the deepest points of both caps
 //   triangle  the triangle, facing the direction
 // If one of the two features is a face whose normal agrees with n to within
-// kFaceCos (1.4e-4 rad: GJK and EPA return a face normal to round-off when a
+// kFaceCos (4.5e-6 rad: GJK and EPA return a face normal to round-off when a
 // face is what touches, and anything looser would tilt the normal of
 // near-face edge contacts), it becomes the reference face (A's when both
 // qualify, so flush faces pick the same one every frame) and the other
@@ -28,8 +28,10 @@
 // face" scheme of Box2D and of Gregorius, "The Separating Axis Test between
 // Convex Polyhedra" (GDC 2013).
 // Two parallel segments (capsule or cylinder sides) give two points over
-// their common extent. Otherwise the contact is the single pair of witness
-// points the caller found.
+// their common extent. Whenever those points fall short of the depth of the
+// witness pair the caller found (a curved feature's polygon, or slightly
+// skew segments whose closest approach is between their ends), the witness
+// pair joins them. Otherwise the contact is the witness pair alone.
 #pragma once
 
 #include "collision/clip.hpp"
@@ -39,7 +41,7 @@
 namespace cairn {
 
 // |cos| of the angle within which a face counts as aligned with the normal.
-constexpr Real kFaceCos = Real(1) - Real(1e-8);  // 1.4e-4 rad
+constexpr Real kFaceCos = Real(1) - Real(1e-11);  // 4.5e-6 rad
 // |sin| below which a segment counts as perpendicular to the normal, or two
 // segments as parallel.
 constexpr Real kSegmentSin = Real(0.0349);  // sin(2 degrees)

@@ -12,6 +12,7 @@
 // level geometry is better reported than silently dropped.
 #include "collision/obj_mesh.hpp"
 
+#include "collision/mesh_bvh.hpp"
 #include "dynamics/error.hpp"
 
 #include <cerrno>
@@ -136,7 +137,9 @@ std::shared_ptr<const TriangleMeshData> loadObjMesh(const std::string& path, con
     if (p.index[0] == p.index[1] || p.index[1] == p.index[2] || p.index[0] == p.index[2]) continue;
     mesh->triangles.push_back({static_cast<int>(p.index[0]), static_cast<int>(p.index[1]), static_cast<int>(p.index[2])});
   }
-  if (mesh->triangles.empty()) throw InputError(object, field, path + ":" + std::to_string(r.line) + ": no triangles (no 'f' records with 3 distinct vertices)");
+  if (mesh->triangles.empty())
+    throw InputError(object, field, path + ":" + std::to_string(r.line) + ": no triangles (no 'f' records with 3 distinct vertices)");
+  buildMeshBvh(*mesh);
   return mesh;
 }
 

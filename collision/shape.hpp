@@ -42,6 +42,17 @@ struct ConvexHullData {
 struct TriangleMeshData {
   std::vector<Vec3> vertices;
   std::vector<std::array<int, 3>> triangles;
+
+  // Optional bounding volume hierarchy over the triangles, filled by
+  // buildMeshBvh() (collision/mesh_bvh.hpp; loadObjMesh does it). Empty:
+  // the narrowphase tests every triangle.
+  struct BvhNode {
+    Vec3 lo, hi;  // bounds of the node's triangles
+    int first;    // leaf: start in bvh_order; inner: index of the left child (right = first + 1)
+    int count;    // leaf: number of triangles; inner: 0
+  };
+  std::vector<BvhNode> bvh;
+  std::vector<int> bvh_order;  // triangle indices, grouped by leaf
 };
 
 struct ShapeDesc {

@@ -47,6 +47,7 @@ TEST(ObjMesh, ValidFileLoadsWithFansNegativeIndicesAndIgnoredRecords) {
   EXPECT_EQ(mesh->triangles[1], (std::array<int, 3>{0, 2, 1}));
   EXPECT_EQ(mesh->triangles[2], (std::array<int, 3>{4, 0, 1}));
   EXPECT_EQ(mesh->vertices[4], Vec3(0, 1, 0));
+  EXPECT_FALSE(mesh->bvh.empty());  // loaded meshes come with their tree
 }
 
 void expectThrowsWith(const std::string& path, const std::string& what) {

@@ -9,5 +9,7 @@ namespace cairn::cli {
 
 void addRunCommand(CLI::App& app, int& status);
 void addSoftnessCommand(CLI::App& app, int& status);
+void addScenesCommand(CLI::App& app, int& status);
+void addValidateCommand(CLI::App& app, int& status);
 
 }  // namespace cairn::cli

@@ -9,6 +9,8 @@ int main(int argc, char** argv) {
   int status = 0;
   cairn::cli::addRunCommand(app, status);
   cairn::cli::addSoftnessCommand(app, status);
+  cairn::cli::addScenesCommand(app, status);
+  cairn::cli::addValidateCommand(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -141,7 +141,7 @@ SceneDesc pile(int per_side) {
 std::vector<std::string> standardNames() {
   return {"pyramid-10", "pyramid-20", "column-10", "column-20", "chain-20", "chain-100",
           "hanging-chain-20", "hinge-pendulum-0.1", "hinge-pendulum-1.5", "mass-ratio-100",
-          "mass-ratio-1000", "pile-1000"};
+          "mass-ratio-1000", "pile-1000", "hinge-chain", "door", "ragdoll", "ramp", "restitution-drop"};
 }
 
 SceneDesc byName(const std::string& key) {
@@ -155,9 +155,216 @@ SceneDesc byName(const std::string& key) {
     if (starts("hinge-pendulum-")) return hingePendulum(std::stod(tail("hinge-pendulum-")));
     if (starts("mass-ratio-")) return massRatio(std::stod(tail("mass-ratio-")));
     if (key == "pile-1000") return pile(10);
+    if (key == "hinge-chain") return hingeChain(5);
+    if (key == "door") return door(5);
+    if (key == "ragdoll") return ragdoll();
+    if (key == "ramp") return ramp();
+    if (key == "restitution-drop") return restitutionDrop(Real(0.8));
   } catch (const std::logic_error&) {
   }
   throw InputError("scenario '" + key + "'", "", "unknown scenario");
+}
+
+}  // namespace cairn::scenarios
+
+// ------------------------------------------------------------------------
+// Scenarios of issue 5 beyond SCENARIOS.md's table. Each sets the table's
+// common conditions itself, sleeping off included.
+
+namespace cairn::scenarios {
+
+namespace {
+
+SceneDesc awake(int steps) {
+  SceneDesc s;
+  s.dt = Real(1) / 60;
+  s.steps = steps;
+  s.solver.sleeping = false;
+  return s;
+}
+
+Quat aboutAxis(Real angle, const Vec3& axis) { return Quat(Eigen::AngleAxis<Real>(angle, axis.normalized())); }
+
+JointDef hinge(const std::string& name, BodyId a, BodyId b, const Vec3& anchor, const Vec3& axis) {
+  JointDef j;
+  j.name = name;
+  j.type = JointType::Hinge;
+  j.body_a = a;
+  j.body_b = b;
+  j.anchor = anchor;
+  j.axis = axis;
+  return j;
+}
+
+}  // namespace
+
+// Planks of 0.2 x 1 x 0.2 m (1 kg) hanging end to end from a hinge about
+// the world z axis at the origin, each joined to the next by a hinge about
+// z; released straight at 0.3 rad from the vertical. No collision within the
+// chain. At this amplitude the motion is close to the linear normal modes,
+// so two engines can be compared step by step for the whole run.
+SceneDesc hingeChain(int links) {
+  SceneDesc s = awake(600);
+  const Real a0 = Real(0.3);
+  const Vec3 down(std::sin(a0), -std::cos(a0), 0);
+  for (int k = 0; k < links; ++k) {
+    BodyDef b;
+    b.name = "plank_" + std::to_string(k);
+    b.mass = 1;
+    b.position = (Real(0.5) + k) * down;
+    b.orientation = aboutAxis(a0, Vec3::UnitZ());
+    b.shapes.push_back(ShapeDesc::box(Vec3(0.1, 0.5, 0.1)));
+    b.collision_group = 2;
+    b.collision_mask = ~2u;
+    s.bodies.push_back(b);
+    s.joints.push_back(hinge("hinge_" + std::to_string(k), k == 0 ? kWorldBody : BodyId{k - 1}, BodyId{k},
+                             Real(k) * down, Vec3::UnitZ()));
+  }
+  return s;
+}
+
+// A 1 x 2 x 0.05 m door of 10 kg hung from the world on a vertical hinge
+// along its left edge (x = 0), with a motor (target 1 rad/s, at most
+// `max_torque` N m) opening it against limits [0, pi/2]. Gravity is along
+// the axis, so only the motor turns it: it accelerates at max_torque / I
+// (I about the edge = m (w^2 + t^2) / 12 + m (w/2)^2), cruises at 1 rad/s
+// and stops on the upper limit, where the motor keeps pushing.
+SceneDesc door(Real max_torque) {
+  SceneDesc s = awake(180);
+  BodyDef d;
+  d.name = "door";
+  d.mass = 10;
+  d.position = Vec3(0.5, 1, 0);
+  d.shapes.push_back(ShapeDesc::box(Vec3(0.5, 1, 0.025)));
+  s.bodies.push_back(d);
+  JointDef j = hinge("hinge", kWorldBody, BodyId{0}, Vec3(0, 1, 0), Vec3::UnitY());
+  j.limit.enabled = true;
+  j.limit.lower = 0;
+  j.limit.upper = kPi / 2;
+  j.motor.enabled = true;
+  j.motor.target_velocity = 1;
+  j.motor.max_force = max_torque;
+  s.joints.push_back(j);
+  return s;
+}
+
+// A 15-part ragdoll (about 1.8 m, 56 kg): box pelvis and chest, capsule
+// head and limbs; cone-twist neck, shoulders and hips, hinge spine, elbows
+// and knees, all with limits. Built standing, then laid face down 1 m above
+// the ground (turned a little about the vertical) and dropped. Its parts
+// collide with the ground and not with each other.
+SceneDesc ragdoll() {
+  SceneDesc s = awake(300);
+  s.bodies.push_back(ground());
+  // Standing pose (feet at y = 0, facing +z), then laid down by `pose`.
+  const Quat lay = aboutAxis(Real(0.3), Vec3::UnitY()) * aboutAxis(kPi / 2, Vec3::UnitX());
+  const Vec3 lift(0, Real(1.1), 0);
+  const auto place = [&](const Vec3& p) -> Vec3 { return lay * (p - Vec3(0, 1, 0)) + lift; };
+  const Quat along_x = aboutAxis(kPi / 2, Vec3::UnitZ());  // a capsule's local y along x
+  const auto part = [&](const std::string& name, Real mass, const Vec3& p, ShapeDesc shape, const Quat& q) {
+    BodyDef b;
+    b.name = name;
+    b.mass = mass;
+    b.position = place(p);
+    b.orientation = lay * q;
+    b.shapes.push_back(std::move(shape));
+    b.collision_group = 2;
+    b.collision_mask = ~2u;
+    s.bodies.push_back(b);
+    return BodyId{static_cast<std::int32_t>(s.bodies.size() - 1)};
+  };
+  const auto joint = [&](JointDef j, const Vec3& anchor, const Vec3& axis) {
+    j.anchor = place(anchor);
+    j.axis = lay * axis;
+    s.joints.push_back(j);
+  };
+  const auto cone = [&](const std::string& name, BodyId a, BodyId b, const Vec3& anchor, const Vec3& axis,
+                        Real span1, Real span2, Real twist) {
+    JointDef j;
+    j.name = name;
+    j.type = JointType::ConeTwist;
+    j.body_a = a;
+    j.body_b = b;
+    j.swing_span1 = span1;
+    j.swing_span2 = span2;
+    j.limit.enabled = true;
+    j.limit.lower = -twist;
+    j.limit.upper = twist;
+    joint(j, anchor, axis);
+  };
+  const auto knuckle = [&](const std::string& name, BodyId a, BodyId b, const Vec3& anchor, const Vec3& axis,
+                           Real lower, Real upper) {
+    JointDef j = hinge(name, a, b, Vec3::Zero(), Vec3::UnitZ());
+    j.limit.enabled = true;
+    j.limit.lower = lower;
+    j.limit.upper = upper;
+    joint(j, anchor, axis);
+  };
+
+  const BodyId pelvis = part("pelvis", 8, Vec3(0, 1.0, 0), ShapeDesc::box(Vec3(0.15, 0.1, 0.1)), Quat::Identity());
+  const BodyId chest = part("chest", 15, Vec3(0, 1.31, 0), ShapeDesc::box(Vec3(0.18, 0.2, 0.1)), Quat::Identity());
+  const BodyId head = part("head", 4, Vec3(0, 1.66, 0), ShapeDesc::capsule(0.1, 0.05), Quat::Identity());
+  knuckle("spine", pelvis, chest, Vec3(0, 1.1, 0), Vec3::UnitX(), Real(-0.3), Real(0.6));
+  cone("neck", chest, head, Vec3(0, 1.51, 0), Vec3::UnitY(), Real(0.5), Real(0.5), Real(0.6));
+  for (int side : {-1, 1}) {
+    const std::string lr = side < 0 ? "left" : "right";
+    const Real sx = Real(side);
+    const BodyId upper_arm =
+        part(lr + "_upper_arm", 2, Vec3(sx * 0.37, 1.45, 0), ShapeDesc::capsule(0.05, 0.1), along_x);
+    const BodyId forearm = part(lr + "_forearm", 1.5, Vec3(sx * 0.67, 1.45, 0), ShapeDesc::capsule(0.045, 0.1), along_x);
+    const BodyId thigh = part(lr + "_thigh", 7, Vec3(sx * 0.09, 0.7, 0), ShapeDesc::capsule(0.07, 0.13), Quat::Identity());
+    const BodyId shin = part(lr + "_shin", 4, Vec3(sx * 0.09, 0.25, 0), ShapeDesc::capsule(0.055, 0.15), Quat::Identity());
+    cone(lr + "_shoulder", chest, upper_arm, Vec3(sx * 0.2, 1.45, 0), Vec3(sx, 0, 0), Real(1.2), Real(1.2), Real(0.5));
+    knuckle(lr + "_elbow", upper_arm, forearm, Vec3(sx * 0.52, 1.45, 0), Vec3(0, -sx, 0), Real(0), Real(2.3));
+    cone(lr + "_hip", pelvis, thigh, Vec3(sx * 0.09, 0.9, 0), Vec3(0, -1, 0), Real(0.8), Real(0.5), Real(0.3));
+    knuckle(lr + "_knee", thigh, shin, Vec3(sx * 0.09, 0.48, 0), Vec3::UnitX(), Real(0), Real(2.2));
+  }
+  return s;
+}
+
+// Two static ramps of 12 x 0.5 x 2 m, at 20 degrees (z = -3) and at 35
+// degrees (z = +3), each descending toward +x, with a 1 m cube of 1 kg
+// resting on it 4 m up the slope; friction 0.5 on both (combined 0.5).
+// tan 20 = 0.36 < 0.5: the first box sticks. tan 35 = 0.70 > 0.5: the second
+// slides with a = g (sin 35 - 0.5 cos 35) = 1.609 m/s^2.
+SceneDesc ramp() {
+  SceneDesc s = awake(180);
+  const Real degrees[2] = {20, 35};
+  for (int k = 0; k < 2; ++k) {
+    const Real theta = degrees[k] * kPi / 180;
+    const Quat q = aboutAxis(-theta, Vec3::UnitZ());
+    const Vec3 normal = q * Vec3::UnitY(), downhill = q * Vec3::UnitX();
+    const Vec3 centre(0, 4, k == 0 ? -3 : 3);
+    const std::string tag = std::to_string(static_cast<int>(degrees[k]));
+    BodyDef r;
+    r.name = "ramp_" + tag;
+    r.type = BodyType::Static;
+    r.position = centre;
+    r.orientation = q;
+    r.friction = Real(0.5);
+    r.shapes.push_back(ShapeDesc::box(Vec3(6, 0.25, 1)));
+    s.bodies.push_back(r);
+    BodyDef b = box("box_" + tag, centre + Real(0.75) * normal - Real(4) * downhill);
+    b.orientation = q;
+    s.bodies.push_back(b);
+  }
+  return s;
+}
+
+// A sphere of radius 0.25 m and 1 kg with restitution e, its bottom 2 m
+// above the ground (restitution 0; cairn combines by the maximum). The
+// first bounce rises to e^2 x 2 m (1.28 m for e = 0.8).
+SceneDesc restitutionDrop(Real restitution) {
+  SceneDesc s = awake(180);
+  s.bodies.push_back(ground());
+  BodyDef b;
+  b.name = "ball";
+  b.mass = 1;
+  b.position = Vec3(0, 2.25, 0);
+  b.restitution = restitution;
+  b.shapes.push_back(ShapeDesc::sphere(0.25));
+  s.bodies.push_back(b);
+  return s;
 }
 
 }  // namespace cairn::scenarios

@@ -22,6 +22,14 @@ SceneDesc hingePendulum(Real amplitude_rad);   // hinge-pendulum
 SceneDesc massRatio(Real ratio);               // mass-ratio-R
 SceneDesc pile(int per_side);                  // pile-1000 for per_side = 10
 
+// Scenarios of issue 5 beyond SCENARIOS.md's table; each sets the
+// table's common conditions itself (no sleeping).
+SceneDesc hingeChain(int links);               // hinge-chain: 5 planks on hinges, released from 0.3 rad
+SceneDesc door(Real max_torque);               // door: a box door on a vertical motorised hinge with limits
+SceneDesc ragdoll();                           // ragdoll: boxes and capsules, cone-twist and hinge joints, dropped
+SceneDesc ramp();                              // ramp: boxes on 20 and 35 degree ramps, mu 0.5
+SceneDesc restitutionDrop(Real restitution);   // restitution-drop: a sphere of e dropped 2 m on the ground
+
 // Scenario by key ("pyramid-10", "column-20", "chain-100",
 // "hinge-pendulum-0.1", "mass-ratio-1000", "pile-1000", ...); throws
 // InputError for an unknown key.

@@ -1,0 +1,217 @@
+// cairn against Bullet (and closed forms) on one scene: run both engines
+// step by step with matched settings, record the same quantities from each,
+// and turn them into figures checked against tolerances.
+//
+// Every per-step quantity is measured by the same code for both engines:
+// Bullet's body states are copied into a shadow cairn World built from the
+// same scene, and energy, momentum, joint error and penetration are read
+// from it exactly as from cairn's own World. Penetration is geometric: the
+// deepest overlap cairn's narrowphase finds between any two shapes that
+// may collide (filtering and joined pairs as the World has them), so the
+// two engines are judged by one ruler (Bullet's own manifold depths would
+// include its collision margins).
+//
+// Two kinds of scene (the scene file's "validation.kind"):
+//   trajectory  deterministic scenes (pendulums, chains, hinges, the door,
+//               the ramp, a bouncing ball): the largest difference between
+//               the engines in body position and orientation over the run.
+//   statistics  chaotic scenes (pyramids, columns, piles, the ragdoll),
+//               where the two engines' step-by-step states part ways by
+//               design: resting height of the top body, the largest
+//               displacement (drift), penetration over the last second and
+//               collapse (any body moved more than 0.5 m), side by side.
+// Both kinds add joint error, energy, momentum and wall time per step, and
+// closed-form references where the scene has one (docs/validation.md, "How
+// to read the report").
+#pragma once
+
+#include "world/scene.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cairn::validation {
+
+enum class ValidationKind { Trajectory, Statistics };
+const char* kindName(ValidationKind k);
+
+// A quantity recorded every step for plots and analytic figures.
+//   height        y of the body's center of mass (m)
+//   x, z          x or z of the center of mass (m)
+//   swing_angle   angle of the center of mass about +z around `pivot`,
+//                 from straight down (rad)
+//   angle         rotation of the body about `axis` since the start (rad)
+//   slope         displacement along `axis` since the start (m)
+struct TraceSpec {
+  std::string body;
+  std::string quantity = "height";
+  Vec3 pivot = Vec3::Zero();
+  Vec3 axis = Vec3::UnitY();
+  std::string label() const { return body + " " + quantity; }
+  std::string unit() const { return quantity == "swing_angle" || quantity == "angle" ? "rad" : "m"; }
+};
+
+// A closed-form reference (the scene file's "validation.analytic" list):
+//   pendulum_period  {body, pivot, value, angle}: period of the swing angle
+//                    (s); also the amplitude over the last period against
+//                    the release angle `angle`
+//   slide            {body, axis, value}: acceleration along `axis`
+//                    (m/s^2) measured after `settle` seconds
+//   stick            {body}: displacement over the run (0 m)
+//   apex_ratio       {body, rest_height, value}: first rebound apex over
+//                    the drop height, both above `rest_height` (e^2)
+//   open_time        {body, axis, angle, value}: time until the body has
+//                    turned 99% of `angle` about `axis` (s); also the
+//                    final angle against `angle`
+//   projectile       {body}: final center of mass against
+//                    x0 + v0 t + g t^2 / 2 (no contact, no joint)
+//   torque_free      {body}: rotational kinetic energy kept (J)
+//   spring_period    {body, value}: period of the spring length (s)
+struct AnalyticSpec {
+  std::string type;
+  std::string body;
+  Vec3 pivot = Vec3::Zero();
+  Vec3 axis = Vec3::UnitY();
+  Real value = 0;
+  Real rest_height = 0;
+  Real angle = 0;
+  Real settle = Real(0.5);
+};
+
+struct ValidationSpec {
+  ValidationKind kind = ValidationKind::Statistics;
+  std::string scenario;  // scenario type ("hinge-pendulum", "column", ...) or "" when inferred
+  // Tolerances by figure key (docs/validation.md lists the keys); a
+  // figure whose key has no tolerance is reported but not checked.
+  std::map<std::string, Real> tolerances;
+  std::vector<TraceSpec> traces;
+  std::vector<AnalyticSpec> analytic;
+  std::string top_body;  // statistics: whose resting height is read (default: highest start)
+  Real collapse_distance = Real(0.5);
+};
+
+// The scene's "validation" block with the defaults for its scenario type
+// filled in; without a block the kind and references are inferred from
+// the scene (a free body: projectile and torque-free; a body on one
+// spring: spring period; joints and no static body: trajectory; else
+// statistics). Throws InputError naming "validation" and the field.
+ValidationSpec validationSpec(const SceneDesc& scene);
+
+// Default tolerances of a scenario type and kind (docs/validation.md).
+std::map<std::string, Real> defaultTolerances(const std::string& scenario, ValidationKind kind);
+
+// One engine's record of a run; index 0 of every series is the start.
+struct EngineRun {
+  std::vector<double> time;
+  std::vector<std::vector<Vec3>> positions;  // [sample][body], center of mass
+  std::vector<std::vector<Quat>> orientations;
+  std::vector<std::vector<Vec3>> velocities;
+  std::vector<double> joint_error;        // largest linear joint error (m)
+  std::vector<double> joint_error_angular; // largest angular joint error (rad)
+  std::vector<double> energy;             // kinetic + potential (J)
+  std::vector<double> rotational_energy;  // sum of 1/2 w.Lw (J)
+  std::vector<Vec3> momentum;             // linear (kg m/s)
+  std::vector<double> penetration;        // deepest overlap (m)
+  std::vector<double> step_seconds;       // wall time of each step (sample 0: 0)
+  std::vector<std::vector<double>> traces;  // [trace][sample]
+  std::vector<double> spring_length;       // first spring (m), if any
+  std::string failure;  // non-empty when the run stopped (e.g. non-finite state)
+  int samples() const { return static_cast<int>(time.size()); }
+};
+
+// A figure of the report: both engines side by side, a closed-form value
+// where there is one, and the check that decides pass or fail (cairn is
+// judged; Bullet's figures are shown for reference).
+enum class Check {
+  None,            // reported only
+  AtMost,          // cairn <= tolerance
+  DiffBullet,      // |cairn - Bullet| <= tolerance
+  DiffAnalytic,    // |cairn - analytic| <= tolerance
+  RelAnalytic,     // |cairn - analytic| / |analytic| <= tolerance
+  NotWorseFlag,    // a yes/no figure (1 = yes): cairn may say yes only if Bullet does
+  RatioBullet,     // cairn <= tolerance x Bullet (no worse than the reference by that factor)
+};
+
+struct Figure {
+  std::string key;   // tolerance key ("position", "period", ...)
+  std::string name;  // for people ("largest position difference")
+  std::string unit;
+  std::optional<double> cairn, bullet, analytic;
+  Check check = Check::None;
+  double tolerance = 0;
+  bool summary = false;  // shown in the one-line-per-scene summary
+  // Filled by evaluate():
+  bool pass = true;
+  double excess = 0;  // how far past the tolerance (in the figure's unit, or a fraction for RelAnalytic)
+  std::string note;
+  void evaluate();
+  std::string checkText() const;  // "|cairn - Bullet| <= 0.01 m"
+};
+
+struct SceneResult {
+  std::string name;    // scenario key or file name as given
+  std::string source;  // the file path, or "standard scenario"
+  std::string description;
+  SceneDesc scene;
+  ValidationSpec spec;
+  EngineRun cairn, bullet;
+  std::vector<Figure> figures;
+  std::vector<std::string> skipped;  // what Bullet lacks (BulletOracle::skipped)
+  bool pass() const;
+  std::vector<const Figure*> failures() const;
+};
+
+// Runs `scene` in cairn and in Bullet (OracleOptions{match_cairn = true})
+// for scene.steps steps and fills cairn, bullet and skipped.
+void runEngines(SceneResult& result);
+
+// Records samples from a cairn World: the real one, or the shadow one that
+// holds Bullet's states. One Recorder per engine (it keeps the first
+// sample as the reference of the traces).
+class Recorder {
+ public:
+  Recorder(const SceneDesc& scene, const ValidationSpec& spec);
+  void record(const World& world, double time, double step_seconds, EngineRun& run);
+
+ private:
+  const ValidationSpec& spec_;
+  std::vector<int> trace_body_;
+  std::vector<std::uint64_t> joined_;  // body pairs a joint keeps apart (sorted keys)
+  bool contacts_possible_ = false;
+  std::vector<Vec3> start_position_;
+  std::vector<Quat> start_orientation_;
+  bool started_ = false;
+};
+
+// Deepest overlap (m, >= 0) between shapes of `world` that may collide:
+// cairn's narrowphase on the current poses, pairs filtered by collision
+// group and mask and by joints (`joined`: sorted keys min(a,b) << 32 | max).
+double geometricPenetration(const World& world, const std::vector<std::uint64_t>& joined);
+
+// Figures from two runs: the comparison proper. Pure: no engine is run.
+std::vector<Figure> compareRuns(const SceneDesc& scene, const ValidationSpec& spec, const EngineRun& cairn,
+                                const EngineRun& bullet);
+
+// The largest difference between two runs over all samples and bodies.
+struct TrajectoryDifference {
+  double position = 0;  // m
+  int position_body = -1, position_sample = -1;
+  double angle = 0;     // rad
+  int angle_body = -1, angle_sample = -1;
+};
+TrajectoryDifference trajectoryDifference(const EngineRun& a, const EngineRun& b);
+
+// Mean period of a signal from its upward crossings of its mean level,
+// linearly interpolated; 0 with fewer than two crossings.
+double measurePeriod(const std::vector<double>& t, const std::vector<double>& x);
+
+// Everything for one scene: run both engines and compare.
+SceneResult validateScene(const SceneDesc& scene, const std::string& name, const std::string& source,
+                          const std::string& description);
+
+}  // namespace cairn::validation

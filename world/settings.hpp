@@ -18,7 +18,7 @@ const char* solverMethodName(SolverMethod m);
 struct SolverSettings {
   SolverMethod method = SolverMethod::PGS;
   int iterations = 10;          // PGS sweeps per step (Bullet: 10)
-  Real tolerance = 0;           // early exit when the residual falls below this; 0 = never
+  Real tolerance = 0;           // early exit when no impulse changed by more than this in a sweep (N s); 0 = never
   Real sor = 1;                 // successive over-relaxation factor, (0, 2)
   bool warm_start = true;       // start from last step's impulses
   Real warm_start_factor = 1;   // scale applied to the carried impulses

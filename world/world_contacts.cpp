@@ -203,16 +203,20 @@ void World::detectContacts(Real h) {
 // Begin events are emitted after the solve so they carry the impulse of
 // their first step; End events name contacts that no longer touch.
 void World::emitContactEvents(const std::vector<Contact>& old) {
-  for (const Contact& c : contacts_) {
-    if (!c.began || !c.enabled) continue;
+  const auto event = [this](const Contact& c, ContactEvent::Type type) {
     ContactEvent e;
-    e.type = ContactEvent::Type::Begin;
+    e.type = type;
     e.step = step_count_;
     e.body_a = c.body_a;
     e.body_b = c.body_b;
     e.shape_a = c.shape_a;
     e.shape_b = c.shape_b;
     e.normal = c.normal;
+    return e;
+  };
+  for (const Contact& c : contacts_) {
+    if (!c.began || !c.enabled) continue;
+    ContactEvent e = event(c, ContactEvent::Type::Begin);
     int deepest = 0;
     for (int i = 0; i < c.count; ++i)
       if (c.points[i].depth > c.points[deepest].depth) deepest = i;
@@ -225,15 +229,7 @@ void World::emitContactEvents(const std::vector<Contact>& old) {
     const auto it = std::lower_bound(contacts_.begin(), contacts_.end(), o.key(),
                                      [](const Contact& x, std::uint64_t k) { return x.key() < k; });
     if (it != contacts_.end() && it->key() == o.key()) continue;
-    ContactEvent e;
-    e.type = ContactEvent::Type::End;
-    e.step = step_count_;
-    e.body_a = o.body_a;
-    e.body_b = o.body_b;
-    e.shape_a = o.shape_a;
-    e.shape_b = o.shape_b;
-    e.normal = o.normal;
-    contact_events_.push_back(e);
+    contact_events_.push_back(event(o, ContactEvent::Type::End));
   }
 }
 

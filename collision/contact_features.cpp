@@ -211,7 +211,7 @@ bool buildManifold(const ConvexProxy& a, const ConvexProxy& b, const Vec3& n, Re
     const bool ref_is_b = cos_a < kFaceCos;  // A's face whenever it qualifies
     // The witness pair is the deepest contact along n, and n is the face
     // normal here, so it belongs in the face's manifold.
-    const ContactPoint witness{Real(0.5) * (wa + wb), depth, pointFeatureId(fa.index, fb.index)};
+    const ContactPoint witness{Real(0.5) * (wa + wb), depth, pointFeatureId(fa.index, fb.index) | 0x10000000u};
     if (faceContact(ref_is_b ? fb : fa, ref_is_b ? fa : fb, ref_is_b, margin, m, &witness) > 0) return true;
   }
   if (fa.count == 2 && fb.count == 2) {
@@ -239,7 +239,7 @@ bool buildManifold(const ConvexProxy& a, const ConvexProxy& b, const Vec3& n, Re
           Real best = -kInf;
           for (int k = 0; k < count; ++k) best = std::max(best, m.points[k].depth);
           if (best < depth - Real(1e-9) * (1 + std::abs(depth)))
-            m.points[count++] = ContactPoint{Real(0.5) * (wa + wb), depth, pointFeatureId(fa.index, fb.index)};
+            m.points[count++] = ContactPoint{Real(0.5) * (wa + wb), depth, pointFeatureId(fa.index, fb.index) | 0x10000000u};
           m.normal = n;
           m.count = count;
           return true;

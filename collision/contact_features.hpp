@@ -78,7 +78,9 @@ int faceContact(const Feature& ref, const Feature& inc, bool ref_is_b, Real marg
 bool buildManifold(const ConvexProxy& a, const ConvexProxy& b, const Vec3& n, Real depth, const Vec3& wa,
                    const Vec3& wb, Real margin, Manifold& m);
 
-// Feature id of a single-point contact from the indices of the features.
+// Feature id of a single-point contact from the indices of the features
+// (bits 0-29; the parallel-segment rule sets bit 29 on its second point, and
+// a witness pair joining a clipped manifold sets bit 28).
 inline std::uint32_t pointFeatureId(int a, int b) {
   return 0x40000000u | ((static_cast<std::uint32_t>(a) & 0x7FFF) << 15) | (static_cast<std::uint32_t>(b) & 0x7FFF);
 }

@@ -8,10 +8,11 @@ namespace cairn {
 namespace {
 
 constexpr int kMaxVerts = 128;
-constexpr int kMaxFaces = 2 * kMaxVerts;
+constexpr int kMaxFaces = 2 * kMaxVerts + 16;  // a closed triangulation has 2V - 4
 
 struct Face {
-  int v[3];
+  int v[3];    // counter-clockwise seen from outside
+  int adj[3];  // face across edge v[e] -> v[e + 1]
   Vec3 n;      // outward unit normal
   Real dist;   // n . w_v0: distance of the plane from the origin
   bool alive;
@@ -20,22 +21,38 @@ struct Face {
 struct Polytope {
   std::array<SimplexVertex, kMaxVerts> verts;
   std::array<Face, kMaxFaces> faces;
-  int nv = 0, nf = 0;
+  std::array<int, kMaxFaces> free_list;
+  int nv = 0, nf = 0, nfree = 0;
 
-  // Adds face (i, j, k), counter-clockwise seen from outside. Returns false
-  // for a sliver with no usable normal.
-  bool addFace(int i, int j, int k) {
-    if (nf >= kMaxFaces) return false;
+  // Adds face (i, j, k), counter-clockwise seen from outside, reusing a dead
+  // slot if there is one. Returns -1 when full or for a sliver with no
+  // usable normal.
+  int addFace(int i, int j, int k) {
     const Vec3& a = verts[i].w;
     const Vec3 n = (verts[j].w - a).cross(verts[k].w - a);
     const Real len = n.norm();
-    if (!(len > 0)) return false;
-    Face& f = faces[nf++];
+    if (!(len > 0)) return -1;
+    int at;
+    if (nfree > 0) at = free_list[--nfree];
+    else if (nf < kMaxFaces) at = nf++;
+    else return -1;
+    Face& f = faces[at];
     f.v[0] = i, f.v[1] = j, f.v[2] = k;
+    f.adj[0] = f.adj[1] = f.adj[2] = -1;
     f.n = n / len;
     f.dist = f.n.dot(a);
     f.alive = true;
-    return true;
+    return at;
+  }
+  void kill(int f) {
+    faces[f].alive = false;
+    free_list[nfree++] = f;
+  }
+  // The edge of face g that leads back to face f.
+  int edgeTo(int g, int f) const {
+    for (int e = 0; e < 3; ++e)
+      if (faces[g].adj[e] == f) return e;
+    return -1;
   }
 };
 
@@ -92,7 +109,8 @@ EpaResult epaPenetration(const ConvexProxy& pa, const ConvexProxy& pb, bool full
   }
 
   // 2. The polytope: faces wound counter-clockwise seen from outside, i.e.
-  //    with normals pointing away from the tetrahedron's centroid.
+  //    with normals pointing away from the tetrahedron's centroid, and each
+  //    face knowing its three neighbours.
   Polytope poly;
   for (int i = 0; i < 4; ++i) poly.verts[poly.nv++] = s.v[i];
   {
@@ -102,12 +120,30 @@ EpaResult epaPenetration(const ConvexProxy& pa, const ConvexProxy& pb, bool full
       int i = f[0], j = f[1], k = f[2];
       const Vec3 n = (poly.verts[j].w - poly.verts[i].w).cross(poly.verts[k].w - poly.verts[i].w);
       if (n.dot(poly.verts[i].w - c) < 0) std::swap(j, k);
-      if (!poly.addFace(i, j, k)) return res;
+      if (poly.addFace(i, j, k) < 0) return res;
     }
+    // Neighbours: the face holding the same edge the other way round.
+    for (int f = 0; f < 4; ++f)
+      for (int e = 0; e < 3; ++e)
+        for (int g = 0; g < 4; ++g)
+          for (int h = 0; h < 3; ++h)
+            if (poly.faces[g].v[h] == poly.faces[f].v[(e + 1) % 3] && poly.faces[g].v[(h + 1) % 3] == poly.faces[f].v[e])
+              poly.faces[f].adj[e] = g;
   }
 
-  // 3. Expand.
-  std::array<std::array<int, 2>, 3 * kMaxFaces> horizon;
+  // 3. Expand. The faces w sees are found by a flood fill from the nearest
+  //    face across neighbours, so they form one connected region and its
+  //    boundary, the horizon, is one loop: on a flat facet of D with many
+  //    support points, visibility decided face by face could leave islands
+  //    and a polytope that is no longer convex.
+  struct HorizonEdge {
+    int a, b;      // edge as wound in the removed face
+    int outside;   // the kept face across it
+  };
+  std::array<HorizonEdge, kMaxFaces> horizon;
+  std::array<int, kMaxFaces> removed;
+  std::array<int, 2 * kMaxFaces> stack;  // (face, edge leading back) pairs
+  std::array<int, kMaxFaces> created;
   int best = -1;
   for (int iter = 0; iter < kMaxVerts; ++iter) {
     res.iterations = iter + 1;
@@ -124,40 +160,75 @@ EpaResult epaPenetration(const ConvexProxy& pa, const ConvexProxy& pb, bool full
     for (int i = 0; i < poly.nv && !repeated; ++i) repeated = (poly.verts[i].w - w.w).squaredNorm() <= tiny * tiny;
     if (repeated) break;
 
-    const int wi = poly.nv++;
-    poly.verts[wi] = w;
-    // Remove the faces w sees; their unpaired edges form the horizon.
-    int nh = 0;
-    for (int f = 0; f < poly.nf; ++f) {
-      Face& face = poly.faces[f];
-      if (!face.alive) continue;
-      // Strictly visible only: a face coplanar with w (common when D is a
-      // polytope with many support points on one facet) stays, or round-off
-      // would decide and could leave a horizon that is not a closed loop.
-      if (face.n.dot(w.w - poly.verts[face.v[0]].w) <= tiny && f != best) continue;
-      face.alive = false;
-      for (int e = 0; e < 3; ++e) {
-        const int i = face.v[e], j = face.v[(e + 1) % 3];
-        int found = -1;
-        for (int h = 0; h < nh; ++h)
-          if (horizon[h][0] == j && horizon[h][1] == i) {
-            found = h;
+    // Flood fill: `best` sees w (gap > tol); a neighbour is removed too when
+    // w is strictly in front of it, else the shared edge is on the horizon.
+    int nr = 0, nh = 0, top = 0;
+    removed[nr++] = best;
+    poly.faces[best].alive = false;
+    for (int e = 2; e >= 0; --e) {
+      stack[top++] = poly.faces[best].adj[e];
+      stack[top++] = poly.edgeTo(poly.faces[best].adj[e], best);
+    }
+    bool broken = false;
+    while (top > 0 && !broken) {
+      const int back = stack[--top];
+      const int g = stack[--top];
+      Face& fg = poly.faces[g];
+      if (!fg.alive) continue;  // already removed (reached another way)
+      if (fg.n.dot(w.w - poly.verts[fg.v[0]].w) > tiny) {
+        fg.alive = false;
+        removed[nr++] = g;
+        for (int k = 2; k >= 1; --k) {  // the two edges other than the way in
+          const int e = (back + k) % 3;
+          if (top + 2 > static_cast<int>(stack.size())) {
+            broken = true;
             break;
           }
-        if (found >= 0) horizon[found] = horizon[--nh];
-        else horizon[nh++] = {i, j};
+          stack[top++] = fg.adj[e];
+          stack[top++] = poly.edgeTo(fg.adj[e], g);
+        }
+      } else {
+        horizon[nh++] = HorizonEdge{fg.v[(back + 1) % 3], fg.v[back], g};
       }
     }
-    // Compact dead faces so the array does not fill with them.
-    int live = 0;
-    for (int f = 0; f < poly.nf; ++f)
-      if (poly.faces[f].alive) poly.faces[live++] = poly.faces[f];
-    poly.nf = live;
+    // A removed face reached from another removed face whose edge was
+    // already taken as horizon (the region closed around it) would leave a
+    // stale horizon edge; drop those whose outside face was removed later.
+    int kept_h = 0;
+    for (int h = 0; h < nh; ++h)
+      if (poly.faces[horizon[h].outside].alive) horizon[kept_h++] = horizon[h];
+    nh = kept_h;
+    // Every new face must have a normal, and there must be room for them.
+    const int room = (kMaxFaces - poly.nf) + poly.nfree + nr;
+    bool fits = !broken && nh >= 3 && nh <= room;
+    for (int h = 0; h < nh && fits; ++h)
+      fits = (poly.verts[horizon[h].b].w - poly.verts[horizon[h].a].w).cross(w.w - poly.verts[horizon[h].a].w).norm() > 0;
+    if (!fits) {
+      for (int r = 0; r < nr; ++r) poly.faces[removed[r]].alive = true;  // undo: stop with this polytope
+      break;
+    }
+    const int wi = poly.nv++;
+    poly.verts[wi] = w;
+    for (int r = 0; r < nr; ++r) poly.kill(removed[r]);
+    // New faces (a, b, w) over the horizon, stitched to the kept faces and
+    // to each other (the face after edge a->b starts at b).
+    for (int h = 0; h < nh; ++h) created[h] = poly.addFace(horizon[h].a, horizon[h].b, wi);
     bool ok = true;
-    for (int h = 0; h < nh && ok; ++h) ok = poly.addFace(horizon[h][0], horizon[h][1], wi);
+    for (int h = 0; h < nh; ++h) {
+      Face& nf = poly.faces[created[h]];
+      const int out = horizon[h].outside;
+      nf.adj[0] = out;
+      for (int e = 0; e < 3; ++e)
+        if (poly.faces[out].v[e] == horizon[h].b && poly.faces[out].v[(e + 1) % 3] == horizon[h].a) poly.faces[out].adj[e] = created[h];
+      for (int k = 0; k < nh; ++k) {
+        if (horizon[k].a == horizon[h].b) nf.adj[1] = created[k];  // edge b -> w
+        if (horizon[k].b == horizon[h].a) nf.adj[2] = created[k];  // edge w -> a
+      }
+      ok = ok && nf.adj[1] >= 0 && nf.adj[2] >= 0;
+    }
     if (!ok) {
-      // Out of room or a sliver: stop with the best face of the last
-      // complete polytope (faces added so far only refine it).
+      // The horizon was not one loop (round-off): stop with the nearest
+      // face of what is left (its distance is still a lower bound).
       best = -1;
       for (int f = 0; f < poly.nf; ++f)
         if (poly.faces[f].alive && (best < 0 || poly.faces[f].dist < poly.faces[best].dist)) best = f;
@@ -166,49 +237,52 @@ EpaResult epaPenetration(const ConvexProxy& pa, const ConvexProxy& pb, bool full
   }
   if (best < 0) return res;
 
-  // 4. The nearest point of the face, in barycentric coordinates, gives the
-  //    two witness points. A flat facet of D is split into coplanar
-  //    triangles of (almost) equal distance, and round-off may pick one
-  //    that does not contain the origin's projection: among the faces in
-  //    the same plane, take the one that contains it best.
-  auto barycentric = [&](const Face& f, Real l[3]) {
+  // 4. The normal and depth are the nearest face's. The witness points are
+  //    where the ray from the origin along that normal leaves the polytope,
+  //    in barycentric coordinates of the face it crosses: usually the
+  //    nearest face itself, but on a flat facet of D split into coplanar
+  //    triangles, or on a curved part tiled by many thin faces, the
+  //    projection can fall just outside it, and clamping would put the two
+  //    witness points off the line of the normal.
+  const Face& fb = poly.faces[best];
+  if (fb.dist < -tol) return res;  // origin outside: round-off broke the expansion
+  auto crossing = [&](const Face& f, Real l[3]) {
+    const Real along = f.n.dot(fb.n);
+    if (!(along > 0)) return -kInf;
+    const Vec3 q = fb.n * (f.dist / along);  // the ray meets f's plane here
     const Vec3& a = poly.verts[f.v[0]].w;
     const Vec3& b = poly.verts[f.v[1]].w;
     const Vec3& c = poly.verts[f.v[2]].w;
-    const Vec3 p = f.n * f.dist;
     const Vec3 n = (b - a).cross(c - a);
     const Real area = n.squaredNorm();
-    l[0] = (c - b).cross(p - b).dot(n) / area;
-    l[1] = (a - c).cross(p - c).dot(n) / area;
+    l[0] = (c - b).cross(q - b).dot(n) / area;
+    l[1] = (a - c).cross(q - c).dot(n) / area;
     l[2] = 1 - l[0] - l[1];
     return std::min({l[0], l[1], l[2]});
   };
   Real l[3];
-  Real inside = barycentric(poly.faces[best], l);
+  int hit = best;
+  Real inside = crossing(fb, l);
   for (int g = 0; g < poly.nf && inside < 0; ++g) {
-    const Face& o = poly.faces[g];
-    if (!o.alive || g == best || std::abs(o.dist - poly.faces[best].dist) > tol || o.n.dot(poly.faces[best].n) < 1 - 1e-9) continue;
-    Real lo[3];
-    const Real in_o = barycentric(o, lo);
-    if (in_o > inside) {
-      inside = in_o;
-      best = g;
-      std::copy(lo, lo + 3, l);
+    if (!poly.faces[g].alive || g == best) continue;
+    Real lg[3];
+    const Real in_g = crossing(poly.faces[g], lg);
+    if (in_g > inside) {
+      inside = in_g;
+      hit = g;
+      std::copy(lg, lg + 3, l);
     }
   }
-  const Face& f = poly.faces[best];
+  const Face& f = poly.faces[hit];
   const SimplexVertex& A = poly.verts[f.v[0]];
   const SimplexVertex& B = poly.verts[f.v[1]];
   const SimplexVertex& C = poly.verts[f.v[2]];
   const Real l1 = std::clamp(l[0], Real(0), Real(1));
   const Real l2 = std::clamp(l[1], Real(0), Real(1) - l1);
   const Real l3 = 1 - l1 - l2;
-  // The origin must be inside (or on) the polytope; a face beyond it means
-  // round-off broke the expansion, and the caller falls back.
-  if (f.dist < -tol) return res;
   res.ok = true;
-  res.normal = f.n;
-  res.depth = f.dist;
+  res.normal = fb.n;
+  res.depth = fb.dist;
   res.point_a = l1 * A.a + l2 * B.a + l3 * C.a;
   res.point_b = l1 * A.b + l2 * B.b + l3 * C.b;
   return res;

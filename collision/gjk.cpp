@@ -80,11 +80,20 @@ Vec3 solveTriangle(Simplex& s) {
     s = *best;
     return bp;
   }
-  const Real v = vb / sum, w = vc / sum;
-  s.lambda[0] = 1 - v - w;
-  s.lambda[1] = v;
-  s.lambda[2] = w;
-  return a + ab * v + ac * w;
+  // Face region. The sub-areas above are differences of products of dot
+  // products: when the triangle is small next to its distance from the
+  // origin (GJK closing in on a curved surface) they cancel badly. The
+  // projection of the origin on the plane, n (n.a) / |n|^2, and sub-areas
+  // measured from that point lose nothing.
+  const Vec3 n = ab.cross(ac);
+  const Real n2 = n.squaredNorm();
+  const Vec3 p = n * (n.dot(a) / n2);
+  const Real la = (b - p).cross(c - p).dot(n) / n2;
+  const Real lb = (c - p).cross(a - p).dot(n) / n2;
+  s.lambda[0] = la;
+  s.lambda[1] = lb;
+  s.lambda[2] = 1 - la - lb;
+  return p;
 }
 
 // Nearest point to the origin on tetrahedron (w0..w3): the origin is inside
@@ -134,8 +143,11 @@ GjkResult gjkDistance(const ConvexProxy& pa, const ConvexProxy& pb, bool full, R
   // Below this the shapes touch: the direction of v is round-off.
   const Real touch2 = Real(1e-20) * scale * scale;
   // Relative accuracy of the distance for curved shapes; polytopes stop
-  // earlier, exactly, on a repeated vertex.
-  const Real eps = Real(1e-10);
+  // earlier, exactly, on a repeated vertex. The direction of v is only known
+  // to sqrt(2 eps) (|v - v*|^2 <= |v|^2 - |v*|^2), and where the nearest
+  // feature is a rim (a kink of the support function) a direction error
+  // costs depth linearly, so eps is near the round-off of |v|^2.
+  const Real eps = Real(1e-13);
 
   Vec3 v = pa.center() - pb.center();
   if (v.squaredNorm() <= touch2) v = Vec3::UnitX();

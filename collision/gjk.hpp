@@ -12,7 +12,8 @@
 // Ericson, "Real-Time Collision Detection", 5.1.5 and 5.1.6). It stops when
 //   |v|^2 - v.w <= eps |v|^2
 // (v.w / |v| is a lower bound and |v| an upper bound of the distance, so the
-// distance is known to relative accuracy eps), when w repeats a simplex
+// distance is known to relative accuracy eps = 1e-13, and the direction of v
+// to sqrt(2 eps)), when w repeats a simplex
 // point (a polytope's exact answer), or when W encloses the origin (overlap).
 // The closest points follow from the barycentric weights of v:
 //   a = sum l_i a_i, b = sum l_i b_i, with w_i = a_i - b_i.

@@ -1,6 +1,7 @@
 // Wavefront OBJ reader for static triangle meshes.
 //
-// The subset read: `v x y z [w]` vertices and `f` faces whose corners are
+// The subset read: `v x y z [w]` vertices (trailing vertex colours ignored)
+// and `f` faces whose corners are
 // `i`, `i/t`, `i//n` or `i/t/n` (only the position index i is used).
 // Indices are 1-based; a negative index counts back from the last vertex
 // defined so far (-1 is the previous vertex), as the format specifies. A face
@@ -90,9 +91,11 @@ std::shared_ptr<const TriangleMeshData> loadObjMesh(const std::string& path, con
       for (int k = 0; k < 3; ++k) {
         if (!(ls >> tok) || !parseReal(tok, v[k])) r.fail("malformed vertex: expected 'v x y z'");
       }
-      if (ls >> tok) {
-        Real w;
-        if (!parseReal(tok, w) || (ls >> tok)) r.fail("malformed vertex: expected 'v x y z [w]'");
+      // An optional w, or the r g b vertex colours some exporters add:
+      // numbers, ignored.
+      for (int extra = 0; ls >> tok; ++extra) {
+        Real ignored;
+        if (extra >= 4 || !parseReal(tok, ignored)) r.fail("malformed vertex: expected 'v x y z [w] [r g b]'");
       }
       if (!v.allFinite()) r.fail("vertex is not finite");
       mesh->vertices.push_back(v);

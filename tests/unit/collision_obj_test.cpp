@@ -31,7 +31,7 @@ TEST(ObjMesh, ValidFileLoadsWithFansNegativeIndicesAndIgnoredRecords) {
                                      "v 0 0 0\n"
                                      "v 1 0 0\n"
                                      "v 1 0 1\n"
-                                     "v 0 0 1\n"
+                                     "v 0 0 1 0.5 0.5 0.5\n"  // vertex colour, ignored
                                      "vn 0 1 0\n"
                                      "vt 0 0\n"
                                      "g group\n"
@@ -64,6 +64,8 @@ void expectThrowsWith(const std::string& path, const std::string& what) {
 
 TEST(ObjMesh, MalformedLinesThrowWithPathAndLine) {
   expectThrowsWith(writeTemp("bad_vertex.obj", "v 0 0 0\nv 1 zero 0\n"), ":2: malformed vertex");
+  expectThrowsWith(writeTemp("short_vertex.obj", "v 0 0\n"), ":1: malformed vertex");
+  expectThrowsWith(writeTemp("long_vertex.obj", "v 0 0 0 1 1 1 1 1\n"), ":1: malformed vertex");
   expectThrowsWith(writeTemp("bad_face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"), ":4: face needs at least 3");
   expectThrowsWith(writeTemp("bad_corner.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n"), ":4: malformed face corner");
   expectThrowsWith(writeTemp("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 9\n"), ":5: face index 9 out of range");

@@ -84,18 +84,18 @@ inline Real refineDepth(const ShapeDesc& a, const Transform& ta, const ShapeDesc
                         std::mt19937& rng) {
   std::normal_distribution<Real> g(0, 1);
   Real f = overlapAlong(a, ta, b, tb, u);
-  for (Real step = 0.1; step > 1e-10; step *= 0.85) {
-    for (int k = 0; k < 24; ++k) {
+  for (Real step = 0.1; step > 1e-10; step *= 0.7) {
+    for (int k = 0; k < 16; ++k) {
       const Vec3 v = (u + step * Vec3(g(rng), g(rng), g(rng))).normalized();
       const Real fv = overlapAlong(a, ta, b, tb, v);
-      if (fv < f) f = fv, u = v, step /= 0.85;
+      if (fv < f) f = fv, u = v, step /= 0.7;
     }
   }
   return f;
 }
 
 // Brute-force minimum of f over the sphere of directions: 4000 Fibonacci
-// directions, then the local search from the best 8 of them and from any
+// directions, then the local search from the best 4 of them and from any
 // extra seed directions given. Accurate to ~1e-9 at smooth or cone-shaped
 // minima; along a ridge (a capsule's or cylinder's rim) random steps rarely
 // stay on it and the search can stop ~1e-5 short, which a seed at the true
@@ -110,9 +110,9 @@ inline Real bruteForceDepth(const ShapeDesc& a, const Transform& ta, const Shape
     const Vec3 u(r * std::cos(golden * i), y, r * std::sin(golden * i));
     samples.emplace_back(overlapAlong(a, ta, b, tb, u), u);
   }
-  std::partial_sort(samples.begin(), samples.begin() + 8, samples.end(),
+  std::partial_sort(samples.begin(), samples.begin() + 4, samples.end(),
                     [](const auto& x, const auto& y) { return x.first < y.first; });
-  samples.resize(8);
+  samples.resize(4);
   for (const Vec3& s : seeds) samples.emplace_back(overlapAlong(a, ta, b, tb, s), s);
   std::mt19937 rng(99);
   Real best = kInf;

@@ -49,6 +49,13 @@ struct RowContext {
   // with a softness of their own keep it in rhs: there ERP and CFM stand for
   // a real spring-damper and must act on the velocities in the same solve.
   Correction correction = Correction::InRhs;
+  // Cap on the speed a rigid linear row's position feedback -ERP/h C may ask
+  // for (m/s), as contacts cap their push-out (settings.max_correction_velocity).
+  Real max_correction_velocity = kInf;
+  // Set by a part whose rows share one error vector (the point part): the
+  // vector's length, so the cap scales its rows together and keeps the
+  // correction's direction. 0: each row's own |C|.
+  Real shared_error_norm = 0;
 };
 
 // Appends one row from its Jacobian. C is the position error (the row

@@ -197,9 +197,9 @@ BodyId World::createBody(const BodyDef& def) {
   b.updateDerived();
 
   // 2. Commit.
+  step_start_.push_back({b.position, b.orientation, b.linear_velocity, b.angular_velocity});  // its last good state
   bodies_.push_back(std::move(b));
   orientation_offset_.push_back(Vec3::Zero());
-  step_start_.push_back({});
   sleep_island_.push_back(-1);
   body_island_.push_back(-1);
   const BodyId id{static_cast<std::int32_t>(bodies_.size() - 1)};

@@ -84,12 +84,21 @@ struct ShapeRef {
   std::int32_t proxy = -1;
 };
 
-// A non-finite value caught by the guard: which body and which stage.
+// A non-finite value caught by the guard (docs/extremes.md, "Safety nets").
+// The guard stops the step for the island it appeared in: every awake
+// dynamic body of that island goes back to its state at the start of the
+// step, at rest, and stays there for the rest of the step; other islands
+// keep stepping. Stages, in step order: "step start" (a state set through
+// the API between steps), "velocity integration", "row building",
+// "constraint solve", "position integration".
 struct NumericalEvent {
   int step = 0;
-  BodyId body;
+  BodyId body;            // the body found non-finite (for a row: its dynamic body)
   std::string body_name;
   std::string stage;
+  std::int32_t island = -1;  // island index of this step; -1: the body was in none (kinematic, or at step start)
+  int bodies_restored = 0;   // bodies put back to their step-start state
+  std::string detail;        // what was non-finite, e.g. "linear velocity" or "joint 'hinge' row 1: rhs"
 };
 
 class World {
@@ -184,8 +193,14 @@ class World {
   void solveRows();
   void storeImpulses(Real h);
   void clearAccumulators();
-  bool guardFinite(const char* stage);
+  // The NaN/Inf guard (world/world_step.cpp).
   void saveStepStart();
+  void saveStepEnd();
+  void guardBodies(const char* stage);
+  void guardRows(const char* stage);
+  void guardIslandSolve(std::int32_t begin, std::int32_t end);
+  void freezeIsland(std::int32_t island, size_t body, const char* stage, std::string detail);
+  void holdFrozen();
   void restoreBody(size_t i);
 
   Vec3 gravity_ = Vec3(0, Real(-9.81), 0);
@@ -214,7 +229,9 @@ class World {
   // Per-step working arrays (sized once, reused: no allocation per step).
   std::vector<Vec3> orientation_offset_;
   struct SavedState { Vec3 x; Quat q; Vec3 v; Vec3 w; };
-  std::vector<SavedState> step_start_;
+  std::vector<SavedState> step_start_;  // last good state: the step's start (or, between steps, the last end)
+  std::vector<char> frozen_island_;     // per island of this step: stopped by the guard
+  bool any_frozen_ = false;
   std::vector<ConstraintRow> rows_;
   std::vector<SolverBody> solver_bodies_;
   std::vector<SolverBody> pseudo_bodies_;  // split-impulse pseudo-velocities (index as solver bodies)

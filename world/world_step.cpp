@@ -15,7 +15,9 @@
 //
 // Collision runs first, on the positions the step starts from, so that
 // restitution sees the approach speed before gravity is added (stage 4).
-// A guard after each stage puts back any body whose state went non-finite.
+// A guard after each stage stops the step for an island in which anything
+// went non-finite (its bodies go back to the step's start, at rest) and lets
+// the other islands step on (docs/extremes.md, "Safety nets").
 #include "dynamics/error.hpp"
 #include "dynamics/forces.hpp"
 #include "dynamics/integrate.hpp"
@@ -24,8 +26,10 @@
 #include "solver/pgs.hpp"
 #include "world/world.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
 
 namespace cairn {
 
@@ -43,19 +47,24 @@ void World::step(Real h) {
   applyExternalForces();                                  // 1
   detectContacts(h);                                      // 2
   buildIslands();                                         // 3
+  frozen_island_.assign(static_cast<size_t>(island_count_), 0);
+  any_frozen_ = false;
   for (int sub = 0; sub < n; ++sub) {
     integrateVelocities(hs);                              // 4
-    if (!guardFinite("velocity integration")) break;
+    guardBodies("velocity integration");
     buildRows(hs);                                        // 5
+    guardRows("row building");
     solveRows();                                          // 6
-    if (!guardFinite("constraint solve")) break;
+    guardRows("constraint solve");
+    guardBodies("constraint solve");
     integratePositions(hs);                               // 7
-    if (!guardFinite("position integration")) break;
+    guardBodies("position integration");
     storeImpulses(hs);                                    // 8
   }
   emitContactEvents(old_contacts_);                       // 9
   updateSleep(h);
   clearAccumulators();
+  saveStepEnd();
 
   for (const Contact& c : contacts_) {
     if (!c.enabled) continue;
@@ -132,6 +141,7 @@ void World::buildRows(Real h) {
       ctx.rows = &rows_;
       ctx.warm = settings_.warm_start ? &j.warm : nullptr;
       ctx.warm_factor = settings_.warm_start_factor;
+      ctx.max_correction_velocity = settings_.max_correction_velocity;
       // The direct and exact solvers solve the ERP target with the rest in
       // one exact solve: nothing is left for a correction pass to fix.
       ctx.correction = settings_.method == SolverMethod::PGS ? settings_.position_correction : Correction::InRhs;
@@ -197,6 +207,7 @@ void World::solveRows() {
       }
     }
     residual = std::max(residual, lcpResidual(rows, solver_bodies_));
+    guardIslandSolve(begin, end);  // a NaN born here stays in its island
   }
   stats_.residual = residual;
   // Position correction in its own passes (constraints/row.hpp, Correction):
@@ -262,9 +273,12 @@ void World::integrateVelocities(Real h) {
     Body& b = bodies_[i];
     if (b.asleep) continue;
     orientation_offset_[i] = integrateVelocity(b, gravity_, h, settings_.gyroscopic);
-    // Safety net: cap the spin rate (off by default).
-    const Real w = b.angular_velocity.norm();
-    if (w > settings_.max_angular_velocity) b.angular_velocity *= settings_.max_angular_velocity / w;
+    // Safety net: cap the spin rate (off by default). stableNorm: |w|^2
+    // must not overflow for the very spins the cap is there to catch.
+    if (settings_.max_angular_velocity < kInf) {
+      const Real w = b.angular_velocity.stableNorm();
+      if (w > settings_.max_angular_velocity) b.angular_velocity *= settings_.max_angular_velocity / w;
+    }
   }
 }
 
@@ -292,7 +306,74 @@ void World::clearAccumulators() {
   }
 }
 
+// --- The NaN/Inf guard ---------------------------------------------------
+//
+// No NaN leaves a step silently. step_start_ holds each body's last good
+// state: taken at the end of every step and again at the start of the next
+// (to keep what the API set in between). After each stage the guard looks
+// for non-finite body states (and, after building and after solving, for
+// non-finite row data, so the stage reported is the one where the NaN was
+// born). The island it finds one in is stopped for the rest of the step:
+// every awake dynamic body of it goes back to its step-start pose, at rest,
+// its rows are made inert (zero Jacobian, zero impulse, so nothing is
+// stored for warm starting and nothing reaches the static bodies other
+// islands share), and it is held there after every later stage. Islands
+// are solved apart, so the others step exactly as if it were not there.
+// One event per stopped island names the body, the stage and the island.
+//
+// Velocities are zeroed rather than restored: the restored island then has
+// no more energy than at the step's start, and a blow-up driven by the
+// velocity itself (a spin the integrator cannot take) is not replayed step
+// after step; see docs/extremes.md.
+
+namespace {
+
+bool finiteState(const Body& b) {
+  return b.position.allFinite() && b.orientation.coeffs().allFinite() && b.linear_velocity.allFinite() &&
+         b.angular_velocity.allFinite();
+}
+
+const char* badField(const Body& b) {
+  if (!b.position.allFinite()) return "position";
+  if (!b.orientation.coeffs().allFinite()) return "orientation";
+  if (!b.linear_velocity.allFinite()) return "linear velocity";
+  return "angular velocity";
+}
+
+// The first non-finite number of a row ("" when all are finite). Bounds may
+// be infinite, never NaN.
+const char* badRowField(const ConstraintRow& r) {
+  if (!std::isfinite(r.rhs)) return "rhs";
+  if (!std::isfinite(r.bias_rhs)) return "position-correction target";
+  if (!std::isfinite(r.lambda)) return "impulse";
+  if (!std::isfinite(r.inv_diag) || !std::isfinite(r.cfm)) return "effective mass";
+  if (!(r.j_lin_a.allFinite() && r.j_ang_a.allFinite() && r.j_lin_b.allFinite() && r.j_ang_b.allFinite() &&
+        r.m_lin_a.allFinite() && r.m_ang_a.allFinite() && r.m_lin_b.allFinite() && r.m_ang_b.allFinite()))
+    return "Jacobian";
+  if (std::isnan(r.lo) || std::isnan(r.hi) || std::isnan(r.mu)) return "bounds";
+  return "";
+}
+
+}  // namespace
+
 void World::saveStepStart() {
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    Body& b = bodies_[i];
+    if (finiteState(b)) {
+      step_start_[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity};
+      continue;
+    }
+    // Set through the API since the last step (Body& access, a NaN impulse):
+    // back to the last good state. Its island has not moved yet, so this
+    // body alone is restored and the step goes on.
+    const char* what = badField(b);
+    restoreBody(i);
+    numerical_events_.push_back({step_count_, BodyId{static_cast<std::int32_t>(i)}, b.name, "step start", -1, 1,
+                                 std::string(what) + " set between steps"});
+  }
+}
+
+void World::saveStepEnd() {
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const Body& b = bodies_[i];
     step_start_[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity};
@@ -310,21 +391,121 @@ void World::restoreBody(size_t i) {
   b.updateDerived();
 }
 
-// No NaN leaves a step silently: a body whose state went non-finite is put
-// back where it was at the start of the step, at rest, and the event names
-// the body and the stage. The rest of the world is untouched.
-bool World::guardFinite(const char* stage) {
-  bool ok = true;
+void World::freezeIsland(std::int32_t island, size_t body, const char* stage, std::string detail) {
+  int restored = 0;
+  if (island < 0) {  // outside every island (kinematic): that body alone
+    restoreBody(body);
+    restored = 1;
+  } else {
+    frozen_island_[static_cast<size_t>(island)] = 1;
+    any_frozen_ = true;
+    for (size_t i = 0; i < bodies_.size(); ++i)
+      if (body_island_[i] == island) ++restored;
+  }
+  numerical_events_.push_back({step_count_, BodyId{static_cast<std::int32_t>(body)}, bodies_[body].name, stage, island,
+                               restored, std::move(detail)});
+  holdFrozen();
+}
+
+// Keeps stopped islands at their step-start pose, at rest, with inert rows.
+void World::holdFrozen() {
+  if (!any_frozen_) return;
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const std::int32_t isl = body_island_[i];
+    if (isl >= 0 && frozen_island_[static_cast<size_t>(isl)]) restoreBody(i);
+  }
+  for (size_t isl = 0; isl < island_rows_.size() && isl < frozen_island_.size(); ++isl) {
+    if (!frozen_island_[isl]) continue;
+    for (std::int32_t k = island_rows_[isl].first; k < island_rows_[isl].second; ++k) {
+      ConstraintRow& r = rows_[static_cast<size_t>(k)];
+      ConstraintRow inert;  // J = 0, rhs = 0, lambda pinned to 0; cfm 1 keeps A_ii > 0 for every solver
+      inert.body_a = r.body_a;
+      inert.body_b = r.body_b;
+      inert.kind = r.kind;
+      inert.owner = r.owner;
+      inert.owner_row = r.owner_row;
+      inert.normal_row = r.normal_row;
+      inert.cfm = 1;
+      inert.inv_diag = 1;
+      inert.lo = inert.hi = 0;
+      r = inert;
+    }
+  }
+}
+
+void World::guardBodies(const char* stage) {
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const Body& b = bodies_[i];
-    if (b.position.allFinite() && b.orientation.coeffs().allFinite() && b.linear_velocity.allFinite() &&
-        b.angular_velocity.allFinite())
-      continue;
-    restoreBody(i);
-    numerical_events_.push_back({step_count_, BodyId{static_cast<std::int32_t>(i)}, b.name, stage});
-    ok = false;
+    if (b.asleep || b.type == BodyType::Static || finiteState(b)) continue;
+    const std::int32_t isl = body_island_[i];
+    if (isl >= 0 && frozen_island_[static_cast<size_t>(isl)]) continue;  // already stopped: held below
+    freezeIsland(isl, i, stage, badField(b));
   }
-  return ok;
+  holdFrozen();
+}
+
+// Called by solveRows right after an island's velocity solve, before the
+// position-correction pass runs over every island's rows: a NaN born in the
+// solve stops its island here, and the solver bodies it touched are reset
+// (its own to rest, static and kinematic ones and the world to their
+// velocities: 0 x inf = NaN would otherwise reach them through their zero
+// inverse mass and, from them, the islands solved next).
+void World::guardIslandSolve(std::int32_t begin, std::int32_t end) {
+  const auto dynamicIndex = [&](std::int32_t solver_index) {
+    return solver_index > 0 && bodies_[static_cast<size_t>(solver_index - 1)].isDynamic() ? solver_index - 1 : -1;
+  };
+  std::int32_t bad_body = -1;
+  std::string detail;
+  for (std::int32_t k = begin; k < end && bad_body < 0; ++k) {
+    const ConstraintRow& r = rows_[static_cast<size_t>(k)];
+    const std::string field = badRowField(r);
+    for (const std::int32_t si : {r.body_b, r.body_a}) {
+      const std::int32_t bi = dynamicIndex(si);
+      if (bi < 0) continue;
+      const SolverBody& sb = solver_bodies_[static_cast<size_t>(si)];
+      if (field.empty() && sb.v.allFinite() && sb.w.allFinite()) continue;
+      bad_body = bi;
+      detail = r.kind >= RowKind::ContactNormal ? std::string("contact row")
+                                                : "joint '" + joints_[static_cast<size_t>(r.owner)].def.name + "' row " +
+                                                      std::to_string(r.owner_row);
+      detail += field.empty() ? std::string(": velocity not finite") : ": " + field + " not finite";
+      break;
+    }
+  }
+  if (bad_body < 0) return;
+  freezeIsland(body_island_[static_cast<size_t>(bad_body)], static_cast<size_t>(bad_body), "constraint solve", detail);
+  for (std::int32_t k = begin; k < end; ++k) {
+    const ConstraintRow& r = rows_[static_cast<size_t>(k)];
+    for (const std::int32_t si : {r.body_a, r.body_b}) {
+      SolverBody& sb = solver_bodies_[static_cast<size_t>(si)];
+      sb = si == 0 ? SolverBody{} : SolverBody{bodies_[static_cast<size_t>(si - 1)].linear_velocity,
+                                               bodies_[static_cast<size_t>(si - 1)].angular_velocity};
+    }
+  }
+}
+
+void World::guardRows(const char* stage) {
+  for (size_t isl = 0; isl < island_rows_.size(); ++isl) {
+    if (frozen_island_[isl]) continue;
+    for (std::int32_t k = island_rows_[isl].first; k < island_rows_[isl].second; ++k) {
+      const ConstraintRow& r = rows_[static_cast<size_t>(k)];
+      const std::string field = badRowField(r);
+      if (field.empty()) continue;
+      std::string what = r.kind >= RowKind::ContactNormal
+                             ? std::string("contact row")
+                             : "joint '" + joints_[static_cast<size_t>(r.owner)].def.name + "' row " +
+                                   std::to_string(r.owner_row);
+      // Name the row's body in this island (solver index = body index + 1).
+      const auto inIsland = [&](std::int32_t solver_index) {
+        return solver_index > 0 && body_island_[static_cast<size_t>(solver_index - 1)] == static_cast<std::int32_t>(isl);
+      };
+      const std::int32_t bi = inIsland(r.body_b) ? r.body_b - 1 : r.body_a - 1;
+      freezeIsland(static_cast<std::int32_t>(isl), static_cast<size_t>(std::max(bi, 0)), stage,
+                   what + ": " + field + " not finite");
+      break;
+    }
+  }
+  holdFrozen();
 }
 
 }  // namespace cairn

@@ -26,11 +26,13 @@
 #pragma once
 
 #include "world/scene.hpp"
+#include "world/world.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -186,6 +188,48 @@ class Recorder {
   std::vector<Vec3> start_position_;
   std::vector<Quat> start_orientation_;
   bool started_ = false;
+};
+
+// One engine's run, stepped by the caller (runEngines steps both in turn;
+// `cairn sweep` runs them apart and looks at the World between steps).
+// The constructor records sample 0; step(s) advances by scene.dt, records
+// sample s and returns false once the run has stopped (the reason is in
+// the EngineRun's failure). `scene` and `spec` must outlive the runner.
+class CairnRunner {
+ public:
+  CairnRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out);
+  bool step(int s);
+  bool running() const { return running_; }
+  const World& world() const { return world_; }
+
+ private:
+  Real dt_;
+  World world_;
+  Recorder recorder_;
+  EngineRun& out_;
+  bool running_ = true;
+};
+
+class BulletOracle;
+
+// Bullet (OracleOptions{match_cairn = true}), measured through a shadow
+// cairn World that holds Bullet's states (see the top of this file).
+class BulletRunner {
+ public:
+  BulletRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out);
+  ~BulletRunner();
+  bool step(int s);
+  bool running() const { return running_; }
+  // What Bullet lacks or maps only approximately (BulletOracle::skipped).
+  const std::vector<std::string>& skipped() const;
+
+ private:
+  Real dt_;
+  World shadow_;
+  std::unique_ptr<BulletOracle> oracle_;
+  Recorder recorder_;
+  EngineRun& out_;
+  bool running_ = true;
 };
 
 // Deepest overlap (m, >= 0) between shapes of `world` that may collide:

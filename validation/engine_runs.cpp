@@ -213,43 +213,60 @@ bool copyStates(const BulletOracle& oracle, World& shadow) {
 
 }  // namespace
 
-void runEngines(SceneResult& r) {
-  const SceneDesc& scene = r.scene;
-  World world = buildWorld(scene);
-  World shadow = buildWorld(scene);
-  BulletOracle oracle(scene);
-  Recorder rc(scene, r.spec), rb(scene, r.spec);
-  rc.record(world, 0, 0, r.cairn);
-  bool bullet_ok = copyStates(oracle, shadow);
-  if (bullet_ok) rb.record(shadow, 0, 0, r.bullet);
-  else r.bullet.failure = "non-finite state at the start";
-  bool cairn_ok = true;
+CairnRunner::CairnRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out)
+    : dt_(scene.dt), world_(buildWorld(scene)), recorder_(scene, spec), out_(out) {
+  recorder_.record(world_, 0, 0, out_);
+}
+
+bool CairnRunner::step(int s) {
+  if (!running_) return false;
   using Clock = std::chrono::steady_clock;
-  for (int s = 1; s <= scene.steps && (cairn_ok || bullet_ok); ++s) {
-    const double t = s * scene.dt;
-    if (cairn_ok) {
-      const auto t0 = Clock::now();
-      world.step(scene.dt);
-      const double sec = std::chrono::duration<double>(Clock::now() - t0).count();
-      if (!world.numericalEvents().empty()) {
-        const auto& ev = world.numericalEvents().front();
-        r.cairn.failure = "body '" + ev.body_name + "': non-finite state in " + ev.stage + " at step " + std::to_string(s);
-        cairn_ok = false;
-      } else {
-        rc.record(world, t, sec, r.cairn);
-      }
-    }
-    if (bullet_ok) {
-      oracle.step();
-      if (!copyStates(oracle, shadow)) {
-        r.bullet.failure = "non-finite state at step " + std::to_string(s);
-        bullet_ok = false;
-      } else {
-        rb.record(shadow, t, oracle.lastStepSeconds(), r.bullet);
-      }
-    }
+  const auto t0 = Clock::now();
+  world_.step(dt_);
+  const double sec = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (!world_.numericalEvents().empty()) {
+    const auto& ev = world_.numericalEvents().front();
+    out_.failure = "body '" + ev.body_name + "': non-finite state in " + ev.stage + " at step " + std::to_string(s);
+    running_ = false;
+    return false;
   }
-  r.skipped = oracle.skipped();
+  recorder_.record(world_, s * dt_, sec, out_);
+  return true;
+}
+
+BulletRunner::BulletRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out)
+    : dt_(scene.dt), shadow_(buildWorld(scene)), oracle_(std::make_unique<BulletOracle>(scene)),
+      recorder_(scene, spec), out_(out) {
+  running_ = copyStates(*oracle_, shadow_);
+  if (running_) recorder_.record(shadow_, 0, 0, out_);
+  else out_.failure = "non-finite state at the start";
+}
+
+BulletRunner::~BulletRunner() = default;
+
+bool BulletRunner::step(int s) {
+  if (!running_) return false;
+  oracle_->step();
+  if (!copyStates(*oracle_, shadow_)) {
+    out_.failure = "non-finite state at step " + std::to_string(s);
+    running_ = false;
+    return false;
+  }
+  recorder_.record(shadow_, s * dt_, oracle_->lastStepSeconds(), out_);
+  return true;
+}
+
+const std::vector<std::string>& BulletRunner::skipped() const { return oracle_->skipped(); }
+
+void runEngines(SceneResult& r) {
+  // One step each in turn, so both runs see the machine in the same state.
+  CairnRunner cairn(r.scene, r.spec, r.cairn);
+  BulletRunner bullet(r.scene, r.spec, r.bullet);
+  for (int s = 1; s <= r.scene.steps && (cairn.running() || bullet.running()); ++s) {
+    cairn.step(s);
+    bullet.step(s);
+  }
+  r.skipped = bullet.skipped();
 }
 
 SceneResult validateScene(const SceneDesc& scene, const std::string& name, const std::string& source,

@@ -1,6 +1,7 @@
 #include "validation/report.hpp"
 
 #include "dynamics/error.hpp"
+#include "validation/plot_script.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -10,10 +11,6 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <cerrno>
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 namespace cairn::validation {
 
@@ -296,31 +293,6 @@ std::string sceneSection(const SceneResult& r, const std::vector<std::string>& p
   return md.str();
 }
 
-// Runs argv[0] with its output and errors into `log`; its exit status, or
-// -1 when it could not be started or did not exit normally.
-int runLogged(const std::vector<std::string>& argv, const std::string& log) {
-  const pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      ::close(fd);
-    }
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    ::execv(args[0], args.data());
-    std::fprintf(stderr, "cannot run %s\n", args[0]);
-    ::_exit(127);
-  }
-  int raw = 0;
-  while (::waitpid(pid, &raw, 0) < 0)
-    if (errno != EINTR) return -1;
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-}
-
 }  // namespace
 
 std::string writeReport(const std::string& dir, const std::vector<SceneResult>& results, const ReportInfo& info) {
@@ -347,17 +319,7 @@ std::string writeReport(const std::string& dir, const std::vector<SceneResult>& 
   writeFile(root / "plots.json", plots.dump(1) + "\n");
 
   if (info.plot_script.empty()) return "validation/plot_report.py not found; plots not drawn";
-  const int status = runLogged({info.python, info.plot_script, root.string()}, (root / "plots.log").string());
-  if (status != 0) {
-    std::ifstream log(root / "plots.log");
-    std::string line, lastLine;
-    while (std::getline(log, line))
-      if (!line.empty()) lastLine = line;
-    return "plots not drawn (" + info.python + " " + info.plot_script + " exited with " + std::to_string(status) +
-           (lastLine.empty() ? "" : ": " + lastLine) + "); see " + (root / "plots.log").string();
-  }
-  fs::remove(root / "plots.log");
-  return "";
+  return runPlotScript(info.python, info.plot_script, root.string());
 }
 
 }  // namespace cairn::validation

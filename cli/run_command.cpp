@@ -1,6 +1,8 @@
 // `cairn run SCENE.json [--steps N] [--dt H] [--out traj.csv] [--every K]
-//  [--metrics m.json]`: simulate a scene and write its trajectory.
+//  [--metrics m.json] [--method pgs|direct|lcp] [--substeps N]
+//  [--iterations N]`: simulate a scene and write its trajectory.
 #include "cli/commands.hpp"
+#include "cli/solver_overrides.hpp"
 #include "dynamics/error.hpp"
 #include "world/scene_json.hpp"
 #include "world/world.hpp"
@@ -26,6 +28,7 @@ struct RunOptions {
   std::string out;
   int every = 1;
   std::string metrics;
+  SolverOverrides solver;
 };
 
 // Figures gathered over a run for the metrics file.
@@ -135,6 +138,7 @@ int runScene(const RunOptions& opt) {
       scene.dt = *opt.dt;
     }
     if (opt.every < 1) throw InputError("--every", "", "must be >= 1");
+    applySolverOverrides(opt.solver, scene);
   } catch (const InputError& e) {
     std::cerr << "cairn run: " << e.what() << "\n";
     return 2;
@@ -173,6 +177,9 @@ int runScene(const RunOptions& opt) {
       m["scene"] = opt.scene;
       m["steps"] = world.stepCount();
       m["dt"] = scene.dt;
+      m["method"] = solverMethodName(scene.solver.method);
+      m["substeps"] = scene.solver.substeps;
+      m["iterations"] = scene.solver.iterations;
       m["body_count"] = world.bodyCount();
       m["wall_time_s"] = wall;
       m["wall_time_per_step_ms"] = world.stepCount() ? 1e3 * wall / world.stepCount() : 0.0;
@@ -201,6 +208,7 @@ void addRunCommand(CLI::App& app, int& status) {
   run->add_option("--out", opt->out, "Trajectory CSV to write");
   run->add_option("--every", opt->every, "Record every K-th step (default 1)");
   run->add_option("--metrics", opt->metrics, "Metrics JSON to write");
+  addSolverOverrideOptions(*run, opt->solver);
   run->callback([opt, &status] { status = runScene(*opt); });
 }
 

@@ -1,4 +1,5 @@
-// `cairn validate SCENE... [--against bullet] [--report DIR] [--steps N]`:
+// `cairn validate SCENE... [--against bullet] [--report DIR] [--steps N]
+//  [--method pgs|direct|lcp] [--substeps N] [--iterations N]`:
 // run each scene in cairn and in Bullet with matched settings and compare
 // them (validation/compare.hpp), with closed forms where they exist.
 //
@@ -11,23 +12,19 @@
 // them; 2 bad input (a missing scene file, a bad scene or validation block,
 // an unwritable report directory), with one line on stderr naming it.
 #include "cli/commands.hpp"
+#include "cli/scene_arg.hpp"
+#include "cli/solver_overrides.hpp"
 #include "dynamics/error.hpp"
 #include "validation/compare.hpp"
+#include "validation/plot_script.hpp"
 #include "validation/report.hpp"
-#include "validation/standard_scenes.hpp"
-#include "world/scene_json.hpp"
-
-#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <sstream>
-#include <unistd.h>
 
 namespace cairn::cli {
 
@@ -41,71 +38,8 @@ struct ValidateOptions {
   std::string against = "bullet";
   std::string report;
   std::optional<int> steps;
+  SolverOverrides solver;
 };
-
-struct Input {
-  SceneDesc scene;
-  std::string name, source, description;
-};
-
-std::string readDescription(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  const auto j = nlohmann::json::parse(ss.str(), nullptr, false);
-  if (j.is_object() && j.contains("description") && j["description"].is_string()) return j["description"].get<std::string>();
-  return "";
-}
-
-// A scene file if one exists at `arg`, else a standard scenario key.
-Input resolve(const std::string& arg) {
-  Input in;
-  std::error_code ec;
-  const bool looks_like_path = arg.find('/') != std::string::npos || fs::path(arg).extension() == ".json";
-  if (fs::exists(arg, ec)) {
-    if (fs::is_directory(arg, ec)) throw InputError(arg, "", "is a directory, not a scene file");
-    in.scene = loadScene(arg);
-    in.name = fs::path(arg).stem().string();
-    in.source = arg;
-    in.description = readDescription(arg);
-  } else if (looks_like_path) {
-    throw InputError(arg, "", "no such scene file");
-  } else {
-    try {
-      validation::StandardScene s = validation::standardScene(arg);
-      in.scene = std::move(s.scene);
-      in.description = std::move(s.description);
-    } catch (const InputError&) {
-      throw InputError(arg, "", "no such scene file or standard scenario (`cairn scenes --list` lists them)");
-    }
-    in.name = arg;
-    in.source = "standard scenario " + arg + " (validation/standard_scenes.cpp)";
-  }
-  // The validation block is checked now, before anything runs.
-  try {
-    (void)validation::validationSpec(in.scene);
-  } catch (const InputError& e) {
-    throw InputError(in.source == arg ? arg + ": " + e.object() : e.object(), e.field(), e.message());
-  }
-  return in;
-}
-
-// validation/plot_report.py: $CAIRN_PLOT_SCRIPT, else next to the source
-// tree the executable was built in (build*/cairn -> ../validation), else
-// under the working directory.
-std::string findPlotScript() {
-  if (const char* env = std::getenv("CAIRN_PLOT_SCRIPT")) return env;
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  std::vector<fs::path> candidates;
-  if (!ec)
-    for (fs::path d = exe.parent_path(); !d.empty() && d != d.root_path(); d = d.parent_path())
-      candidates.push_back(d / "validation" / "plot_report.py");
-  candidates.push_back(fs::current_path(ec) / "validation" / "plot_report.py");
-  for (const auto& c : candidates)
-    if (fs::exists(c, ec)) return c.string();
-  return "";
-}
 
 std::string utcNow() {
   const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
@@ -120,18 +54,20 @@ std::string commandLine(const ValidateOptions& opt) {
   std::string cmd = "cairn validate";
   for (const auto& s : opt.scenes) cmd += " " + s;
   if (opt.steps) cmd += " --steps " + std::to_string(*opt.steps);
+  cmd += solverOverridesText(opt.solver);
   if (!opt.report.empty()) cmd += " --report " + opt.report;
   return cmd;
 }
 
 int validate(const ValidateOptions& opt) {
-  std::vector<Input> inputs;
+  std::vector<SceneArg> inputs;
   try {
     if (opt.against != "bullet") throw InputError("--against", "", "only 'bullet' is available");
     if (opt.steps && *opt.steps < 1) throw InputError("--steps", "", "must be >= 1");
     for (const auto& s : opt.scenes) {
-      inputs.push_back(resolve(s));
+      inputs.push_back(resolveSceneArg(s));
       if (opt.steps) inputs.back().scene.steps = *opt.steps;
+      applySolverOverrides(opt.solver, inputs.back().scene);
     }
     if (!opt.report.empty()) validation::prepareReportDir(opt.report);
   } catch (const InputError& e) {
@@ -140,7 +76,7 @@ int validate(const ValidateOptions& opt) {
   }
 
   std::vector<SceneResult> results;
-  for (const Input& in : inputs) {
+  for (const SceneArg& in : inputs) {
     std::cout << "validating " << in.name << ": " << in.scene.bodies.size() << " bodies, " << in.scene.joints.size()
               << " joints, " << in.scene.steps << " steps, cairn and Bullet...\n"
               << std::flush;
@@ -162,7 +98,7 @@ int validate(const ValidateOptions& opt) {
     validation::ReportInfo info;
     info.command = commandLine(opt);
     info.date = utcNow();
-    info.plot_script = findPlotScript();
+    info.plot_script = validation::findPlotScript("plot_report.py");
     try {
       const std::string warning = validation::writeReport(opt.report, results, info);
       if (!warning.empty()) std::cerr << "cairn validate: warning: " << warning << "\n";
@@ -184,6 +120,7 @@ void addValidateCommand(CLI::App& app, int& status) {
   cmd->add_option("--against", opt->against, "Reference engine (only 'bullet')");
   cmd->add_option("--report", opt->report, "Directory for report.md, CSVs and PNG plots");
   cmd->add_option("--steps", opt->steps, "Number of steps (overrides each scene's)");
+  addSolverOverrideOptions(*cmd, opt->solver);
   cmd->callback([opt, &status] { status = validate(*opt); });
 }
 

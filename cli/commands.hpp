@@ -11,5 +11,6 @@ void addRunCommand(CLI::App& app, int& status);
 void addSoftnessCommand(CLI::App& app, int& status);
 void addScenesCommand(CLI::App& app, int& status);
 void addValidateCommand(CLI::App& app, int& status);
+void addSweepCommand(CLI::App& app, int& status);
 
 }  // namespace cairn::cli

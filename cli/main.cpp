@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   cairn::cli::addSoftnessCommand(app, status);
   cairn::cli::addScenesCommand(app, status);
   cairn::cli::addValidateCommand(app, status);
+  cairn::cli::addSweepCommand(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -28,14 +28,21 @@ inline std::uint64_t nextRandom(std::uint64_t& s) {
   return z ^ (z >> 31);
 }
 
-inline Real solveRow(ConstraintRow& r, std::span<ConstraintRow> rows, std::span<SolverBody> bodies, Real sor) {
-  SolverBody& a = bodies[r.body_a];
-  SolverBody& b = bodies[r.body_b];
-  Real lo = r.lo, hi = r.hi;
+// Bounds of row i at this moment (friction: +-mu lambda_n of its normal row).
+inline void rowBounds(const ConstraintRow& r, std::span<const ConstraintRow> rows, Real& lo, Real& hi) {
+  lo = r.lo;
+  hi = r.hi;
   if (r.normal_row >= 0) {
     hi = r.mu * rows[r.normal_row].lambda;
     lo = -hi;
   }
+}
+
+inline Real solveRow(ConstraintRow& r, std::span<ConstraintRow> rows, std::span<SolverBody> bodies, Real sor) {
+  SolverBody& a = bodies[r.body_a];
+  SolverBody& b = bodies[r.body_b];
+  Real lo, hi;
+  rowBounds(r, rows, lo, hi);
   const Real delta = (r.rhs - rowVelocity(r, a, b) - r.cfm * r.lambda) * r.inv_diag;
   const Real next = std::clamp(r.lambda + sor * delta, lo, hi);
   const Real d = next - r.lambda;
@@ -118,6 +125,58 @@ inline Real solveUnit(std::span<ConstraintRow> rows, std::span<SolverBody> bodie
   return solveBlock(&rows[static_cast<size_t>(begin)], end - begin, &s.block[static_cast<size_t>(s.block_of[u])], bodies, sor);
 }
 
+// One sweep over the units, in order or shuffled; returns the largest change.
+inline Real sweep(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, const PgsSettings& s,
+                  PgsScratch& scratch, std::uint64_t& rng_state) {
+  Real max_delta = 0;
+  const size_t units = scratch.block_of.size();
+  if (s.randomize_order) {
+    for (size_t i = units - 1; i > 0; --i)  // Fisher-Yates
+      std::swap(scratch.order[i], scratch.order[nextRandom(rng_state) % (i + 1)]);
+    for (std::int32_t u : scratch.order)
+      max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, static_cast<size_t>(u), s.sor));
+  } else {
+    for (size_t u = 0; u < units; ++u) max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, u, s.sor));
+  }
+  return max_delta;
+}
+
+// The NNCG momentum step (Silcowitz, Niebe and Erleben 2010, "A nonsmooth
+// nonlinear conjugate gradient method for interactive contact force
+// problems", The Visual Computer 26): with d_k = lambda_k+1 - lambda_k the
+// change of this sweep,
+//     beta = |d_k|^2 / |d_k-1|^2,   restart (p = 0) when beta > 1,
+//     lambda += beta p  (projected on the bounds),   p = beta p + d_k.
+// Gauss-Seidel removes the error of a stiff chain (a stack, a heavy body on
+// a light one) one link per sweep; the momentum carries the correction the
+// sweeps keep making in the same direction (docs/constraints.md measures it).
+inline void momentumStep(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, PgsScratch& s, Real& prev_norm2) {
+  Real norm2 = 0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const Real d = rows[i].lambda - s.previous[i];
+    s.previous[i] = d;  // reused to hold d_k
+    norm2 += d * d;
+  }
+  const Real beta = prev_norm2 > 0 ? norm2 / prev_norm2 : Real(0);
+  prev_norm2 = norm2;
+  if (beta == 0 || beta > 1) {  // first sweep: p = d; beta > 1 (the sweeps stopped agreeing): restart, p = 0
+    for (size_t i = 0; i < rows.size(); ++i) s.direction[i] = beta == 0 ? s.previous[i] : Real(0);
+    return;
+  }
+  for (size_t i = 0; i < rows.size(); ++i) {
+    ConstraintRow& r = rows[i];
+    Real lo, hi;
+    rowBounds(r, rows, lo, hi);
+    const Real next = std::clamp(r.lambda + beta * s.direction[i], lo, hi);
+    const Real d = next - r.lambda;
+    if (d != 0) {
+      r.lambda = next;
+      applyImpulse(r, bodies[r.body_a], bodies[r.body_b], d);
+    }
+    s.direction[i] = beta * s.direction[i] + s.previous[i];
+  }
+}
+
 }  // namespace
 
 void applyWarmStart(std::span<const ConstraintRow> rows, std::span<SolverBody> bodies) {
@@ -135,19 +194,21 @@ PgsStats solvePgs(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, c
     scratch.order.resize(units);
     for (size_t u = 0; u < units; ++u) scratch.order[u] = static_cast<std::int32_t>(u);
   }
+  Real prev_norm2 = 0;
+  if (s.nncg) {
+    scratch.previous.resize(rows.size());
+    scratch.direction.assign(rows.size(), Real(0));
+  }
   for (int it = 0; it < s.iterations; ++it) {
-    Real max_delta = 0;
-    if (s.randomize_order) {
-      for (size_t i = units - 1; i > 0; --i)  // Fisher-Yates
-        std::swap(scratch.order[i], scratch.order[nextRandom(rng_state) % (i + 1)]);
-      for (std::int32_t u : scratch.order)
-        max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, static_cast<size_t>(u), s.sor));
-    } else {
-      for (size_t u = 0; u < units; ++u) max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, u, s.sor));
-    }
+    if (s.nncg)
+      for (size_t i = 0; i < rows.size(); ++i) scratch.previous[i] = rows[i].lambda;
+    const Real max_delta = sweep(rows, bodies, s, scratch, rng_state);
     stats.iterations = it + 1;
     stats.last_max_delta = max_delta;
     if (s.tolerance > 0 && max_delta <= s.tolerance) break;
+    // No momentum after the last sweep: it would leave the rows unprojected
+    // by a sweep (the result must be a PGS iterate).
+    if (s.nncg && it + 1 < s.iterations) momentumStep(rows, bodies, scratch, prev_norm2);
   }
   return stats;
 }

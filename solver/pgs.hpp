@@ -37,6 +37,7 @@ struct PgsSettings {
   bool randomize_order = false;
   std::uint64_t seed = 1;
   bool manifold_blocks = true;  // solve each manifold's normal rows as one block
+  bool nncg = true;             // conjugate-gradient momentum between sweeps (pgs.cpp, momentumStep)
 };
 
 struct PgsStats {
@@ -50,6 +51,8 @@ struct PgsScratch {
   std::vector<std::int32_t> block_of;    // per unit: offset of its block matrix in `block`, or -1
   std::vector<Real> block;               // blocks' A_b, n x n row-major (n <= 4)
   std::vector<std::int32_t> order;       // unit visiting order (randomized)
+  std::vector<Real> previous;            // NNCG: lambda before the sweep, then its change
+  std::vector<Real> direction;           // NNCG: the momentum direction p
 };
 
 // Adds M^-1 J^T lambda of every row to the velocities.

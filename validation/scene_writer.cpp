@@ -57,6 +57,7 @@ Json solverJson(const SolverSettings& s) {
   j["warm_start"] = s.warm_start;
   j["warm_start_factor"] = s.warm_start_factor;
   j["randomize_order"] = s.randomize_order;
+  j["nncg"] = s.nncg;
   j["seed"] = s.seed;
   j["substeps"] = s.substeps;
   j["erp"] = s.erp;

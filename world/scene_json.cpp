@@ -330,6 +330,7 @@ SolverSettings parseSolver(const json& j) {
   s.warm_start = r.boolean("warm_start", s.warm_start);
   s.warm_start_factor = r.number("warm_start_factor", s.warm_start_factor);
   s.randomize_order = r.boolean("randomize_order", s.randomize_order);
+  s.nncg = r.boolean("nncg", s.nncg);
   if (r.has("seed")) s.seed = r.raw("seed").get<std::uint64_t>();
   s.substeps = r.integer("substeps", s.substeps);
   s.erp = r.number("erp", s.erp);

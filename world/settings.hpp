@@ -23,6 +23,7 @@ struct SolverSettings {
   bool warm_start = true;       // start from last step's impulses
   Real warm_start_factor = 1;   // scale applied to the carried impulses
   bool randomize_order = false; // shuffle rows each sweep (seeded, reproducible)
+  bool nncg = true;             // PGS with NNCG momentum between sweeps (solver/pgs.cpp); false: plain PGS as Bullet
   std::uint64_t seed = 1;
   int substeps = 1;             // sub-steps per step
 

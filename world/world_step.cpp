@@ -176,8 +176,9 @@ void World::solveRows() {
     rng_state_ = settings_.seed;
     rng_seeded_ = true;
   }
-  const PgsSettings ps{settings_.iterations, settings_.tolerance, settings_.sor, settings_.randomize_order,
-                       settings_.seed};
+  PgsSettings ps{settings_.iterations, settings_.tolerance, settings_.sor, settings_.randomize_order,
+                 settings_.seed};
+  ps.nncg = settings_.nncg;
   std::span<ConstraintRow> all(rows_);
   Real residual = 0;
   for (const auto& [begin, end] : island_rows_) {

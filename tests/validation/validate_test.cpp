@@ -94,6 +94,7 @@ void expectSameScene(const SceneDesc& a, const SceneDesc& b) {
   EXPECT_EQ(s.warm_start, t.warm_start);
   EXPECT_EQ(s.warm_start_factor, t.warm_start_factor);
   EXPECT_EQ(s.randomize_order, t.randomize_order);
+  EXPECT_EQ(s.nncg, t.nncg);
   EXPECT_EQ(s.seed, t.seed);
   EXPECT_EQ(s.substeps, t.substeps);
   EXPECT_EQ(s.erp, t.erp);

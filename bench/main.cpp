@@ -5,6 +5,8 @@
 //   cairn_bench --table chain-whip           chain-20 whip: cairn and Bullet vs iterations
 //   cairn_bench --table correction           position-correction modes compared
 //   cairn_bench --table mass-ratio           hinge limit on a small box on a long arm
+//   cairn_bench --table extremes [NAME]      the extremes suite: cairn default, best, Bullet
+//   cairn_bench --table extremes-variants NAME  every setting the suite tried on those cases
 //
 // The tables measure physics, not time, so they are deterministic.
 #include <benchmark/benchmark.h>
@@ -17,6 +19,8 @@ namespace cairn::bench {
 int chainWhipTable();
 int correctionTable();
 int massRatioTable();
+int extremesTable(const std::string& filter);
+int extremesVariantsTable(const std::string& filter);
 }  // namespace cairn::bench
 
 int main(int argc, char** argv) {
@@ -25,7 +29,9 @@ int main(int argc, char** argv) {
     if (which == "chain-whip") return cairn::bench::chainWhipTable();
     if (which == "correction") return cairn::bench::correctionTable();
     if (which == "mass-ratio") return cairn::bench::massRatioTable();
-    std::cerr << "cairn_bench: --table takes chain-whip, correction or mass-ratio\n";
+    if (which == "extremes-variants") return cairn::bench::extremesVariantsTable(argc >= 4 ? argv[3] : "");
+    if (which == "extremes") return cairn::bench::extremesTable(argc >= 4 ? argv[3] : "");
+    std::cerr << "cairn_bench: --table takes chain-whip, correction, mass-ratio or extremes\n";
     return 2;
   }
   benchmark::Initialize(&argc, argv);

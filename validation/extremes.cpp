@@ -179,7 +179,7 @@ const char* driftMeasureName(DriftMeasure m) {
     case DriftMeasure::JointSeparation: return "largest anchor separation (m)";
     case DriftMeasure::Displacement: return "largest body displacement";
     case DriftMeasure::WallPenetration: return "depth past the wall's face (m)";
-    case DriftMeasure::AngularMomentum: return "|L - L0| / |L0|";
+    case DriftMeasure::AngularMomentum: return "angular momentum drift, relative";
     case DriftMeasure::MaxSpeed: return "largest body speed (m/s)";
   }
   return "";

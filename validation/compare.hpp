@@ -95,6 +95,17 @@ struct ValidationSpec {
   std::vector<AnalyticSpec> analytic;
   std::string top_body;  // statistics: whose resting height is read (default: highest start)
   Real collapse_distance = Real(0.5);
+  // Trajectory scenes: the position and angle differences are checked over
+  // [0, horizon] seconds only (0: the whole run); the whole run's figures
+  // are still reported. A chaotic motion (chain-20's whip) parts two
+  // engines, or one engine from itself at another iteration count, after
+  // a while; past that time only statistics are comparable.
+  Real horizon = 0;
+  // Also run cairn with the exact bilateral solve (method "direct") as the
+  // reference trajectory ("reference": "direct"), and report each engine's
+  // distance from it over the horizon: which engine is closer to the
+  // converged solution of the same equations, not only whether they agree.
+  bool direct_reference = false;
 };
 
 // The scene's "validation" block with the defaults for its scenario type
@@ -162,6 +173,7 @@ struct SceneResult {
   SceneDesc scene;
   ValidationSpec spec;
   EngineRun cairn, bullet;
+  EngineRun reference;  // cairn, method "direct", when spec.direct_reference
   std::vector<Figure> figures;
   std::vector<std::string> skipped;  // what Bullet lacks (BulletOracle::skipped)
   bool pass() const;
@@ -239,7 +251,7 @@ double geometricPenetration(const World& world, const std::vector<std::uint64_t>
 
 // Figures from two runs: the comparison proper. Pure: no engine is run.
 std::vector<Figure> compareRuns(const SceneDesc& scene, const ValidationSpec& spec, const EngineRun& cairn,
-                                const EngineRun& bullet);
+                                const EngineRun& bullet, const EngineRun* reference = nullptr);
 
 // The largest difference between two runs over all samples and bodies.
 struct TrajectoryDifference {
@@ -248,7 +260,8 @@ struct TrajectoryDifference {
   double angle = 0;     // rad
   int angle_body = -1, angle_sample = -1;
 };
-TrajectoryDifference trajectoryDifference(const EngineRun& a, const EngineRun& b);
+// Samples after `until` seconds (when > 0) are left out.
+TrajectoryDifference trajectoryDifference(const EngineRun& a, const EngineRun& b, double until = 0);
 
 // Mean period of a signal from its upward crossings of its mean level,
 // linearly interpolated; 0 with fewer than two crossings.

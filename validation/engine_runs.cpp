@@ -267,6 +267,13 @@ void runEngines(SceneResult& r) {
     bullet.step(s);
   }
   r.skipped = bullet.skipped();
+  if (r.spec.direct_reference) {  // the exact bilateral solve of the same scene, after the timed runs
+    SceneDesc exact = r.scene;
+    exact.solver.method = SolverMethod::Direct;
+    CairnRunner reference(exact, r.spec, r.reference);
+    for (int s = 1; s <= r.scene.steps && reference.step(s); ++s) {
+    }
+  }
 }
 
 SceneResult validateScene(const SceneDesc& scene, const std::string& name, const std::string& source,
@@ -278,7 +285,7 @@ SceneResult validateScene(const SceneDesc& scene, const std::string& name, const
   r.scene = scene;
   r.spec = validationSpec(scene);
   runEngines(r);
-  r.figures = compareRuns(r.scene, r.spec, r.cairn, r.bullet);
+  r.figures = compareRuns(r.scene, r.spec, r.cairn, r.bullet, r.spec.direct_reference ? &r.reference : nullptr);
   return r;
 }
 

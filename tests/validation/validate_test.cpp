@@ -502,6 +502,54 @@ TEST(Comparison, FlagsADeliberatelyPerturbedTrajectory) {
   EXPECT_TRUE(figure(figs, "position")->pass);
 }
 
+// A horizon leaves the later samples out of the checked difference (the
+// perturbation from t = 1 s on is invisible over the first 0.9 s and the
+// whole run's figure still shows it), and a reference run puts each
+// engine's distance from it side by side under a ratio check.
+TEST(Comparison, HorizonAndExactReferenceJudgeOnlyThePredictableWindow) {
+  const EngineRun a = straightRun(120, 2);
+  EngineRun b = a, far = a;
+  for (int s = 60; s < 120; ++s) b.positions[size_t(s)][1] += Vec3(0, 0.1, 0);
+  for (int s = 1; s < 120; ++s) far.positions[size_t(s)][0] += Vec3(0.01 * s, 0, 0);
+  EXPECT_EQ(trajectoryDifference(a, b, 0.9).position, 0);
+  EXPECT_NEAR(trajectoryDifference(a, b, 1.0).position, 0.1, 1e-12);
+
+  const SceneDesc scene = twoBodyScene();
+  ValidationSpec spec;
+  spec.kind = ValidationKind::Trajectory;
+  spec.horizon = 0.9;
+  spec.tolerances = {{"position", 0.05}, {"reference_distance", 1.5}};
+  // cairn = a (on the reference), Bullet = far (0.01 m per sample off it).
+  std::vector<Figure> figs = compareRuns(scene, spec, a, far, &b);
+  const Figure* pos = figure(figs, "position");
+  const Figure* whole = figure(figs, "position_whole_run");
+  const Figure* ref = figure(figs, "reference_distance");
+  ASSERT_TRUE(pos && whole && ref);
+  EXPECT_NEAR(*pos->cairn, 0.01 * 54, 1e-9);  // sample 54 is t = 0.9 s
+  EXPECT_NEAR(*whole->cairn, 0.01 * 119, 1e-9);
+  EXPECT_EQ(whole->check, Check::None);
+  EXPECT_EQ(*ref->cairn, 0);                  // b matches a before t = 1 s
+  EXPECT_NEAR(*ref->bullet, 0.01 * 54, 1e-9);
+  EXPECT_TRUE(ref->pass);
+  figs = compareRuns(scene, spec, far, a, &b);  // the engines swapped: cairn is the one off the reference
+  EXPECT_FALSE(figure(figs, "reference_distance")->pass);
+
+  // chain-N gets the horizon and the reference by default; bad values are named.
+  const ValidationSpec chain = validationSpec(standardScene("chain-20").scene);
+  EXPECT_EQ(chain.horizon, 1);
+  EXPECT_TRUE(chain.direct_reference);
+  SceneDesc bad = standardScene("hinge-pendulum-0.1").scene;
+  bad.validation_json = R"({"reference": "bullet"})";
+  try {
+    (void)validationSpec(bad);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "reference");
+  }
+  bad.validation_json = R"({"horizon": -1})";
+  EXPECT_THROW((void)validationSpec(bad), InputError);
+}
+
 // Each check type: where the boundary is, and what "excess" means.
 TEST(Comparison, ChecksPassAtTheToleranceAndReportTheExcess) {
   Figure f;

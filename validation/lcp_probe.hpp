@@ -32,8 +32,9 @@
 //      the state the step started from, as the World computes it.
 //
 // PGS with joints and several substeps is neither: the probe then reports
-// nothing rather than a wrong figure. Islands of more than `max_rows` rows
-// are skipped too (the exact solver is dense, O(n^3)).
+// nothing rather than a wrong figure. Nor does it when an island has more
+// than `max_rows` rows (the exact solver is dense, O(n^3)) or the exact
+// solver does not converge (it can cycle on a stack's redundant contacts).
 #pragma once
 
 #include "dynamics/body.hpp"

@@ -137,7 +137,8 @@ SweepRow SweepRunner::run(const SweepJob& job) {
   EngineRun run;
   CairnRunner cairn(scene, spec_, run);
   ExactLcpProbe probe;
-  double residual = 0, distance = -1, velocity = -1;
+  double residual = 0, distance = 0, velocity = 0;
+  int sampled = 0, unmeasured = 0;
   std::string why;
   for (int s = 1; s <= scene.steps; ++s) {
     const bool sample = exact_every_ > 0 && s % exact_every_ == 0;
@@ -146,20 +147,26 @@ SweepRow SweepRunner::run(const SweepJob& job) {
     residual = std::max(residual, double(cairn.world().lastStepStats().residual));
     if (!sample) continue;
     if (const auto d = probe.afterStep(cairn.world(), scene.dt)) {
-      distance = std::max(distance, d->lambda);
-      velocity = std::max(velocity, d->velocity);
-    } else if (why.empty()) {
-      why = probe.why();
+      distance += d->lambda;
+      velocity += d->velocity;
+      ++sampled;
+    } else {
+      if (why.empty()) why = probe.why();
+      ++unmeasured;
     }
   }
   const int bullet_job = bulletJobFor(plan_, job);
   fill(row, scene, spec_, run, bullet_job >= 0 ? bulletRun(bullet_job) : EngineRun{});
   if (run.samples() > 1) row.values[size_t(Measure::Residual)] = residual;
-  if (distance >= 0) {
-    row.values[size_t(Measure::ExactDistance)] = distance;
-    row.values[size_t(Measure::ExactVelocity)] = velocity;
+  if (sampled > 0) {
+    row.values[size_t(Measure::ExactDistance)] = distance / sampled;
+    row.values[size_t(Measure::ExactVelocity)] = velocity / sampled;
   }
-  else if (exact_every_ > 0) row.notes = "no exact LCP distance: " + cell(why.empty() ? "no step sampled" : why);
+  if (sampled == 0 && exact_every_ > 0)
+    row.notes = "no exact LCP distance: " + cell(why.empty() ? "no step sampled" : why);
+  else if (unmeasured > 0)
+    row.notes = "exact LCP distance over " + std::to_string(sampled) + " of " + std::to_string(sampled + unmeasured) +
+                " sampled steps; the others: " + cell(why);
   return row;
 }
 

@@ -73,20 +73,30 @@ TEST(BallChain, HangingChainOfTwentyStaysWithinOneMillimetre) {
 // NNCG's momentum (the default) converges far enough in 10 sweeps that the
 // single pass settles too: the growth is a symptom of unconverged sweeps.
 TEST(BallChain, SinglePassBaumgarteGrowsUnderPlainPgsWhereTwoPassSettles) {
+  struct Result {
+    Real worst = 0, end = 0;
+  };
   const auto run = [](Correction c, bool nncg) {
     World w = hangingChain(20, 10);
     SolverSettings s = w.settings();
     s.position_correction = c;
     s.nncg = nncg;
     w.setSettings(s);
-    for (int st = 0; st < 600; ++st) w.step(kH);
-    return worstJointError(w);
+    Result r;
+    for (int st = 0; st < 600; ++st) {
+      w.step(kH);
+      r.worst = std::max(r.worst, worstJointError(w));
+    }
+    r.end = worstJointError(w);
+    return r;
   };
-  EXPECT_GT(run(Correction::InRhs, false), 0.1);
-  EXPECT_LT(run(Correction::VelocityBias, false), 1e-4);
-  EXPECT_LT(run(Correction::PseudoVelocity, false), 1e-4);
-  EXPECT_LT(run(Correction::InRhs, true), 1e-4);
-  EXPECT_LT(run(Correction::VelocityBias, true), 1e-4);
+  // Once grown, the links fold and hit each other, so the end value is
+  // chaotic; the largest error over the run is what grows.
+  EXPECT_GT(run(Correction::InRhs, false).worst, 0.1);
+  EXPECT_LT(run(Correction::VelocityBias, false).end, 1e-4);
+  EXPECT_LT(run(Correction::PseudoVelocity, false).end, 1e-4);
+  EXPECT_LT(run(Correction::InRhs, true).end, 1e-4);
+  EXPECT_LT(run(Correction::VelocityBias, true).end, 1e-4);
 }
 
 // Chain of 20 spheres released horizontally (SCENARIOS.md chain-20): a whip

@@ -7,6 +7,12 @@ namespace cairn {
 
 namespace {
 
+// A sweep that moved no impulse by more than this fraction of the largest
+// impulse has reached a fixed point to round-off (double precision keeps
+// about 16 digits): further sweeps would repeat it, so the solve stops
+// there. `iterations` is the most sweeps a solve makes.
+constexpr Real kRoundOff = Real(1e-13);
+
 inline Real rowVelocity(const ConstraintRow& r, const SolverBody& a, const SolverBody& b) {
   return r.j_lin_a.dot(a.v) + r.j_ang_a.dot(a.w) + r.j_lin_b.dot(b.v) + r.j_ang_b.dot(b.w);
 }
@@ -38,7 +44,8 @@ inline void rowBounds(const ConstraintRow& r, std::span<const ConstraintRow> row
   }
 }
 
-inline Real solveRow(ConstraintRow& r, std::span<ConstraintRow> rows, std::span<SolverBody> bodies, Real sor) {
+inline Real solveRow(ConstraintRow& r, std::span<ConstraintRow> rows, std::span<SolverBody> bodies, Real sor,
+                     Real& lambda_max) {
   SolverBody& a = bodies[r.body_a];
   SolverBody& b = bodies[r.body_b];
   Real lo, hi;
@@ -48,6 +55,7 @@ inline Real solveRow(ConstraintRow& r, std::span<ConstraintRow> rows, std::span<
   const Real d = next - r.lambda;
   r.lambda = next;
   applyImpulse(r, a, b, d);
+  lambda_max = std::max(lambda_max, std::abs(next));
   return std::abs(d);
 }
 
@@ -81,7 +89,8 @@ inline void factorBlock(const Real* a_b, const ConstraintRow* r, int n, Real* l)
 // vanish. Otherwise (a corner lifting, an impact) local projected sweeps on
 // A_b until no row's velocity error exceeds 1e-9 of the largest, at most
 // 32; they cost a few flops each and touch no body.
-inline Real solveBlock(ConstraintRow* r, int n, const Real* a_b, const Real* l, std::span<SolverBody> bodies, Real sor) {
+inline Real solveBlock(ConstraintRow* r, int n, const Real* a_b, const Real* l, std::span<SolverBody> bodies, Real sor,
+                       Real& lambda_max) {
   SolverBody& a = bodies[r[0].body_a];
   SolverBody& b = bodies[r[0].body_b];
   Real residual[4], lambda[4], delta[4] = {0, 0, 0, 0};
@@ -91,7 +100,7 @@ inline Real solveBlock(ConstraintRow* r, int n, const Real* a_b, const Real* l, 
     lambda[i] = r[i].lambda;
     scale = std::max(scale, std::abs(residual[i]));
   }
-  const Real tol = Real(1e-9) * scale;
+  const Real tol = Real(1e-6) * scale;
 
   // All points active: forward and back substitution with L.
   Real y[4];
@@ -139,6 +148,7 @@ inline Real solveBlock(ConstraintRow* r, int n, const Real* a_b, const Real* l, 
     r[i].lambda = lambda[i];
     applyImpulse(r[i], a, b, delta[i]);
     max_delta = std::max(max_delta, std::abs(delta[i]));
+    lambda_max = std::max(lambda_max, std::abs(lambda[i]));
   }
   return max_delta;
 }
@@ -172,26 +182,26 @@ void buildUnits(std::span<const ConstraintRow> rows, bool blocks, PgsScratch& s)
 }
 
 inline Real solveUnit(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, const PgsScratch& s, size_t u,
-                      Real sor) {
+                      Real sor, Real& lambda_max) {
   const std::int32_t begin = s.unit_begin[u], end = s.unit_begin[u + 1];
-  if (s.block_of[u] < 0) return solveRow(rows[static_cast<size_t>(begin)], rows, bodies, sor);
+  if (s.block_of[u] < 0) return solveRow(rows[static_cast<size_t>(begin)], rows, bodies, sor, lambda_max);
   const int n = end - begin;
   const Real* a_b = &s.block[static_cast<size_t>(s.block_of[u])];
-  return solveBlock(&rows[static_cast<size_t>(begin)], n, a_b, a_b + n * n, bodies, sor);
+  return solveBlock(&rows[static_cast<size_t>(begin)], n, a_b, a_b + n * n, bodies, sor, lambda_max);
 }
 
 // One sweep over the units, in order or shuffled; returns the largest change.
 inline Real sweep(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, const PgsSettings& s,
-                  PgsScratch& scratch, std::uint64_t& rng_state) {
+                  PgsScratch& scratch, std::uint64_t& rng_state, Real& lambda_max) {
   Real max_delta = 0;
   const size_t units = scratch.block_of.size();
   if (s.randomize_order) {
     for (size_t i = units - 1; i > 0; --i)  // Fisher-Yates
       std::swap(scratch.order[i], scratch.order[nextRandom(rng_state) % (i + 1)]);
     for (std::int32_t u : scratch.order)
-      max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, static_cast<size_t>(u), s.sor));
+      max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, static_cast<size_t>(u), s.sor, lambda_max));
   } else {
-    for (size_t u = 0; u < units; ++u) max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, u, s.sor));
+    for (size_t u = 0; u < units; ++u) max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, u, s.sor, lambda_max));
   }
   return max_delta;
 }
@@ -257,10 +267,12 @@ PgsStats solvePgs(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, c
   for (int it = 0; it < s.iterations; ++it) {
     if (s.nncg)
       for (size_t i = 0; i < rows.size(); ++i) scratch.previous[i] = rows[i].lambda;
-    const Real max_delta = sweep(rows, bodies, s, scratch, rng_state);
+    Real lambda_max = 0;
+    const Real max_delta = sweep(rows, bodies, s, scratch, rng_state, lambda_max);
     stats.iterations = it + 1;
     stats.last_max_delta = max_delta;
     if (s.tolerance > 0 && max_delta <= s.tolerance) break;
+    if (max_delta <= kRoundOff * lambda_max) break;  // a fixed point to round-off: more sweeps change nothing
     // No momentum after the last sweep: it would leave the rows unprojected
     // by a sweep (the result must be a PGS iterate).
     if (s.nncg && it + 1 < s.iterations) momentumStep(rows, bodies, scratch, prev_norm2);
@@ -278,7 +290,7 @@ bool solvePgsCorrection(std::span<const ConstraintRow> rows, std::span<SolverBod
   if (!any) return false;
   lambda.assign(rows.size(), 0);
   for (int it = 0; it < s.iterations; ++it) {
-    Real max_delta = 0;
+    Real max_delta = 0, lambda_max = 0;
     for (size_t i = 0; i < rows.size(); ++i) {
       const ConstraintRow& r = rows[i];
       if (r.correction != which) continue;
@@ -290,8 +302,10 @@ bool solvePgsCorrection(std::span<const ConstraintRow> rows, std::span<SolverBod
       lambda[i] = next;
       applyImpulse(r, a, b, d);
       max_delta = std::max(max_delta, std::abs(d));
+      lambda_max = std::max(lambda_max, std::abs(next));
     }
     if (s.tolerance > 0 && max_delta <= s.tolerance) break;
+    if (max_delta <= kRoundOff * lambda_max) break;
   }
   return true;
 }

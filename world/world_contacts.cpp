@@ -144,11 +144,15 @@ void World::detectContacts(Real h) {
       contacts_.push_back(c);
     }
   }
-  std::stable_sort(contacts_.begin(), contacts_.end(), [](const Contact& x, const Contact& y) { return x.key() < y.key(); });
+  // Contacts in key order (deterministic, and for the lookup below). The
+  // broadphase hands pairs over in a stable order, so this is usually
+  // sorted already: checking first spares moving every contact.
+  const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
+  if (!std::is_sorted(contacts_.begin(), contacts_.end(), by_key)) std::stable_sort(contacts_.begin(), contacts_.end(), by_key);
 
   // 3. Warm start: carry impulses from last step's points with the same
   //    feature id (or, failing that, within 2 cm on body A).
-  std::sort(old_contacts_.begin(), old_contacts_.end(), [](const Contact& x, const Contact& y) { return x.key() < y.key(); });
+  if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key)) std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
   for (Contact& c : contacts_) {
     const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
                                      [](const Contact& x, std::uint64_t k) { return x.key() < k; });

@@ -54,8 +54,7 @@ void World::step(Real h) {
     guardBodies("velocity integration");
     buildRows(hs);                                        // 5
     guardRows("row building");
-    solveRows();                                          // 6
-    guardRows("constraint solve");
+    solveRows();                                          // 6 (guards each island's rows after its solve)
     guardBodies("constraint solve");
     integratePositions(hs);                               // 7
     guardBodies("position integration");
@@ -344,6 +343,13 @@ const char* badField(const Body& b) {
 // The first non-finite number of a row ("" when all are finite). Bounds may
 // be infinite, never NaN.
 const char* badRowField(const ConstraintRow& r) {
+  // Fast path: a NaN or infinity anywhere makes the sum non-finite (the
+  // bounds may be infinite and are tested apart). Only a sum that is not
+  // finite, rare, is looked at field by field.
+  const Real sum = r.rhs + r.bias_rhs + r.lambda + r.inv_diag + r.cfm + r.mu + r.j_lin_a.sum() + r.j_ang_a.sum() +
+                   r.j_lin_b.sum() + r.j_ang_b.sum() + r.m_lin_a.sum() + r.m_ang_a.sum() + r.m_lin_b.sum() +
+                   r.m_ang_b.sum();
+  if (std::isfinite(sum) && !std::isnan(r.lo) && !std::isnan(r.hi)) return "";
   if (!std::isfinite(r.rhs)) return "rhs";
   if (!std::isfinite(r.bias_rhs)) return "position-correction target";
   if (!std::isfinite(r.lambda)) return "impulse";
@@ -459,17 +465,17 @@ void World::guardIslandSolve(std::int32_t begin, std::int32_t end) {
   std::string detail;
   for (std::int32_t k = begin; k < end && bad_body < 0; ++k) {
     const ConstraintRow& r = rows_[static_cast<size_t>(k)];
-    const std::string field = badRowField(r);
+    const char* field = badRowField(r);
     for (const std::int32_t si : {r.body_b, r.body_a}) {
       const std::int32_t bi = dynamicIndex(si);
       if (bi < 0) continue;
       const SolverBody& sb = solver_bodies_[static_cast<size_t>(si)];
-      if (field.empty() && sb.v.allFinite() && sb.w.allFinite()) continue;
+      if (*field == 0 && sb.v.allFinite() && sb.w.allFinite()) continue;
       bad_body = bi;
       detail = r.kind >= RowKind::ContactNormal ? std::string("contact row")
                                                 : "joint '" + joints_[static_cast<size_t>(r.owner)].def.name + "' row " +
                                                       std::to_string(r.owner_row);
-      detail += field.empty() ? std::string(": velocity not finite") : ": " + field + " not finite";
+      detail += *field == 0 ? std::string(": velocity not finite") : ": " + std::string(field) + " not finite";
       break;
     }
   }
@@ -490,8 +496,8 @@ void World::guardRows(const char* stage) {
     if (frozen_island_[isl]) continue;
     for (std::int32_t k = island_rows_[isl].first; k < island_rows_[isl].second; ++k) {
       const ConstraintRow& r = rows_[static_cast<size_t>(k)];
-      const std::string field = badRowField(r);
-      if (field.empty()) continue;
+      const char* field = badRowField(r);
+      if (*field == 0) continue;
       std::string what = r.kind >= RowKind::ContactNormal
                              ? std::string("contact row")
                              : "joint '" + joints_[static_cast<size_t>(r.owner)].def.name + "' row " +
@@ -502,7 +508,7 @@ void World::guardRows(const char* stage) {
       };
       const std::int32_t bi = inIsland(r.body_b) ? r.body_b - 1 : r.body_a - 1;
       freezeIsland(static_cast<std::int32_t>(isl), static_cast<size_t>(std::max(bi, 0)), stage,
-                   what + ": " + field + " not finite");
+                   what + ": " + std::string(field) + " not finite");
       break;
     }
   }

@@ -25,7 +25,7 @@ constexpr Key kKeys[] = {
     {"erp", Type::Real},          {"dt", Type::Real},           {"cfm", Type::Real},
     {"contact_erp", Type::Real},  {"sor", Type::Real},          {"tolerance", Type::Real},
     {"warm_start", Type::Bool},   {"warm_start_factor", Type::Real}, {"randomize_order", Type::Bool},
-    {"split_impulse", Type::Bool}, {"slop", Type::Real},
+    {"split_impulse", Type::Bool}, {"slop", Type::Real},        {"nncg", Type::Bool},
 };
 
 const Key* findKey(const std::string& name) {
@@ -112,6 +112,7 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
       else if (value != "false" && value != "0") bad(option, value, "is not true, false, 1 or 0");
       if (key == "warm_start") s.warm_start = v;
       else if (key == "randomize_order") s.randomize_order = v;
+      else if (key == "nncg") s.nncg = v;
       else s.split_impulse = v;
       break;
     }
@@ -157,6 +158,7 @@ std::string solverKeyValue(const SceneDesc& scene, const std::string& key) {
   if (key == "randomize_order") return s.randomize_order ? "true" : "false";
   if (key == "split_impulse") return s.split_impulse ? "true" : "false";
   if (key == "slop") return exactNumberText(s.slop);
+  if (key == "nncg") return s.nncg ? "true" : "false";
   throw InputError("solver", key, "unknown setting");
 }
 

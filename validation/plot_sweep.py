@@ -87,7 +87,7 @@ def main(argv):
                 parts.append("Bullet" if method == "bullet" else method)
             elif k == "substeps":
                 parts.append(f"{first[k]} substep" + ("" if first[k] == "1" else "s"))
-            else:
+            elif first[k] != "-":  # "-": a setting Bullet does not see
                 parts.append(f"{k} {first[k]}")
         style = {"marker": markers.get(method, "o"), "markersize": 5, "linewidth": 1.3}
         if method == "bullet":

@@ -13,6 +13,11 @@ namespace {
 
 const std::vector<std::string> kAlwaysShown = {"method", "substeps", "iterations", "erp", "dt"};
 
+// Settings that do not reach Bullet (docs/validation.md, "How settings
+// map"): a Bullet job shows "bullet" for the method and "-" for the rest,
+// and one Bullet run serves every value of them.
+bool bulletIgnores(const std::string& key) { return key == "method" || key == "nncg"; }
+
 int columnOf(const SweepPlan& plan, const std::string& key) {
   const auto it = std::find(plan.columns.begin(), plan.columns.end(), key);
   return it == plan.columns.end() ? -1 : int(it - plan.columns.begin());
@@ -78,10 +83,10 @@ SweepPlan makeSweepPlan(const std::vector<VaryAxis>& axes, const SceneDesc& scen
   }
   plan.cairn_jobs = int(plan.jobs.size());
 
-  const int method = columnOf(plan, "method");
   for (int i = 0; i < plan.cairn_jobs; ++i) {
     SweepJob b = plan.jobs[size_t(i)];
-    b.settings[size_t(method)] = "bullet";
+    for (size_t c = 0; c < plan.columns.size(); ++c)
+      if (bulletIgnores(plan.columns[c])) b.settings[c] = plan.columns[c] == "method" ? "bullet" : "-";
     b.bullet = true;
     const bool seen = std::any_of(plan.jobs.begin() + plan.cairn_jobs, plan.jobs.end(),
                                   [&](const SweepJob& j) { return j.settings == b.settings; });
@@ -96,7 +101,7 @@ SceneDesc jobScene(const SweepPlan& plan, const SweepJob& job, const SceneDesc& 
   SceneDesc scene = base;
   for (size_t c = 0; c < plan.columns.size(); ++c) {
     const std::string& key = plan.columns[c];
-    if (key == "method" && job.bullet) continue;  // Bullet has one solver; the scene's method is not read
+    if (job.bullet && bulletIgnores(key)) continue;  // the scene keeps its value; Bullet does not read it
     setSolverKey(scene, key, job.settings[c], "--vary " + key);
   }
   if (scene.dt != base.dt) scene.steps = std::max(1, int(std::lround(base.steps * base.dt / scene.dt)));
@@ -104,12 +109,11 @@ SceneDesc jobScene(const SweepPlan& plan, const SweepJob& job, const SceneDesc& 
 }
 
 int bulletJobFor(const SweepPlan& plan, const SweepJob& job) {
-  const int method = columnOf(plan, "method");
   for (int i = plan.cairn_jobs; i < int(plan.jobs.size()); ++i) {
     const SweepJob& b = plan.jobs[size_t(i)];
     bool same = true;
     for (size_t c = 0; c < plan.columns.size() && same; ++c)
-      same = int(c) == method || b.settings[c] == job.settings[c];
+      same = bulletIgnores(plan.columns[c]) || b.settings[c] == job.settings[c];
     if (same) return i;
   }
   return -1;

@@ -5,9 +5,11 @@
 // Order: the first --vary key is the outermost loop, the last the
 // innermost; values in the order written. Jobs 0 .. C-1 are cairn's
 // combinations in that order; jobs C .. C+B-1 are Bullet's, one per
-// distinct combination of the settings other than `method` (Bullet has
-// one solver; the oracle runs `substeps` Bullet steps of dt/substeps per
-// step, so substeps do reach it), in order of first appearance.
+// distinct combination of the settings Bullet sees, in order of first
+// appearance: all but `method` (Bullet has one solver) and `nncg` (no
+// Bullet counterpart), which its rows show as "bullet" and "-". The
+// oracle runs `substeps` Bullet steps of dt/substeps per step, so
+// substeps do reach Bullet.
 //
 // A shard i/n (0 <= i < n) runs the jobs whose index % n == i.
 #pragma once
@@ -32,8 +34,8 @@ VaryAxis parseVary(const std::string& arg, const SceneDesc& scene);
 struct SweepJob {
   int index = 0;
   bool bullet = false;
-  // One value per setting column (SweepPlan::columns), "bullet" as the
-  // method of a Bullet job.
+  // One value per setting column (SweepPlan::columns); a Bullet job has
+  // "bullet" as its method and "-" for settings Bullet does not see.
   std::vector<std::string> settings;
 };
 

@@ -27,7 +27,9 @@ std::string cell(const validation::ExtremeResult& r, bool energy_bound) {
     bounded += buf;
   }
   std::snprintf(buf, sizeof buf, "%.3g", r.drift);
-  return finite + " / " + bounded + " / " + (r.finite ? std::string(buf) : "-");
+  std::string drift = r.finite ? std::string(buf) : "-";
+  if (r.diagnostics > 0) drift += " (diagnosed in " + std::to_string(r.diagnostics) + " steps)";
+  return finite + " / " + bounded + " / " + drift;
 }
 
 }  // namespace

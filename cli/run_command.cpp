@@ -168,6 +168,9 @@ int runScene(const RunOptions& opt) {
     if (!opt.out.empty() && s % opt.every == 0) appendRows(csv, world, s);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (const Diagnostic& d : world.diagnostics())
+    std::cerr << "cairn run: " << opt.scene << ": body '" << d.body_name << "': " << d.kind << " in " << d.count
+              << " (sub)steps from step " << d.first_step + 1 << ": " << d.detail << "\n";
   if (status != 0) return status;
 
   try {
@@ -184,6 +187,11 @@ int runScene(const RunOptions& opt) {
       m["wall_time_s"] = wall;
       m["wall_time_per_step_ms"] = world.stepCount() ? 1e3 * wall / world.stepCount() : 0.0;
       m["energy_initial"] = e0;
+      nlohmann::json diags = nlohmann::json::array();
+      for (const Diagnostic& d : world.diagnostics())
+        diags.push_back({{"body", d.body_name}, {"kind", d.kind}, {"detail", d.detail}, {"first_step", d.first_step + 1},
+                         {"count", d.count}});
+      m["diagnostics"] = diags;
       m["energy_final"] = world.kineticEnergy() + world.potentialEnergy();
       fig.write(m, world);
       writeAtomically(opt.metrics, m.dump(2) + "\n");

@@ -13,7 +13,8 @@ namespace cairn {
 // Returns the world-frame angular velocity offset that the position stage
 // must add for the orientation to advance at the midpoint velocity
 // (non-zero only for Gyroscopic::ImplicitMidpoint; see integrate.cpp).
-Vec3 integrateVelocity(Body& b, const Vec3& gravity, Real h, Gyroscopic gyro);
+// `gyro_converged` (optional) reports the implicit-midpoint solve's outcome.
+Vec3 integrateVelocity(Body& b, const Vec3& gravity, Real h, Gyroscopic gyro, bool* gyro_converged = nullptr);
 
 // x += h v; q advanced by h (w + orientation_offset); derived data refreshed.
 // Static bodies do not move; kinematic and dynamic bodies do.
@@ -23,6 +24,9 @@ void integratePosition(Body& b, Real h, OrientationIntegrator method,
 // Body-frame angular velocity after one torque-free gyroscopic step of each
 // kind, exposed for tests and docs. `w` and the result are body-frame.
 Vec3 gyroscopicImplicitEuler(const Mat3& inertia, const Vec3& w, Real h);
-Vec3 gyroscopicImplicitMidpoint(const Mat3& inertia, const Vec3& w, Real h);
+// `converged` (optional) is set false when Newton's method could not solve
+// the midpoint equation to 1e-10 |L|: the step then does not conserve E and
+// |L| to round-off, and the caller should say so.
+Vec3 gyroscopicImplicitMidpoint(const Mat3& inertia, const Vec3& w, Real h, bool* converged = nullptr);
 
 }  // namespace cairn

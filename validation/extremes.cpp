@@ -422,6 +422,7 @@ ExtremeResult runCairn(const ExtremeCase& c, const SolverSettings& settings) {
     if (!t.r.finite) break;  // cannot happen while the guard works: recorded, not hidden
   }
   t.r.numerical_events = static_cast<int>(w.numericalEvents().size());
+  for (const Diagnostic& d : w.diagnostics()) t.r.diagnostics += d.count;
   return t.finish();
 }
 
@@ -448,7 +449,9 @@ ExtremeResult runBullet(const ExtremeCase& c) {
 
 BestResult runBest(const ExtremeCase& c) {
   BestResult best{"default", runCairn(c, c.scene.solver)};
-  const auto holds = [](const ExtremeResult& r) { return r.finite && r.numerical_events == 0 && r.bounded; };
+  const auto holds = [](const ExtremeResult& r) {
+    return r.finite && r.numerical_events == 0 && r.diagnostics == 0 && r.bounded;
+  };
   std::vector<SettingVariant> variants = standardVariants();
   variants.insert(variants.end(), c.extra_variants.begin(), c.extra_variants.end());
   for (const SettingVariant& v : variants) {

@@ -57,6 +57,7 @@ struct ExtremeCase {
 struct ExtremeResult {
   bool finite = true;
   int numerical_events = 0;
+  int diagnostics = 0;  // (sub)steps the World reported as inaccurate (World::diagnostics)
   std::string first_event;     // "body 'x': stage (detail)"
   double energy_excess = 0;    // max over the run of (E(t) - E(0)) / S
   bool bounded = true;         // energy_excess <= kEnergyMargin (or no bound)

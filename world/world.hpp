@@ -101,6 +101,23 @@ struct NumericalEvent {
   std::string detail;        // what was non-finite, e.g. "linear velocity" or "joint 'hinge' row 1: rhs"
 };
 
+// A step the engine took but could not take accurately, reported rather
+// than passed on silently (docs/extremes.md, "Safety nets"). One entry per
+// body and kind, counting the (sub)steps it happened in. Kinds:
+//   "gyroscopic solve"  the implicit-midpoint gyroscopic step did not solve
+//                       its equation to 1e-10 |L| (h |w| too large for the
+//                       body's inertia ratio): energy and angular momentum
+//                       are not conserved in those steps; substeps with
+//                       h |w| < 1 restore it.
+struct Diagnostic {
+  BodyId body;
+  std::string body_name;
+  std::string kind;
+  std::string detail;
+  int first_step = 0;
+  int count = 0;  // how many (sub)steps it happened in
+};
+
 class World {
  public:
   World() = default;
@@ -169,6 +186,8 @@ class World {
   const StepStats& lastStepStats() const { return stats_; }
   // Non-finite states caught and rolled back (never silently passed on).
   const std::vector<NumericalEvent>& numericalEvents() const { return numerical_events_; }
+  // Steps taken but not taken accurately (Diagnostic above), since creation.
+  const std::vector<Diagnostic>& diagnostics() const { return diagnostics_; }
   // Joints broken during the last step.
   const std::vector<JointBreakEvent>& jointBreakEvents() const { return break_events_; }
 
@@ -245,6 +264,8 @@ class World {
   Real time_ = 0;
   StepStats stats_;
   std::vector<NumericalEvent> numerical_events_;
+  std::vector<Diagnostic> diagnostics_;
+  void diagnose(size_t body, const char* kind, const std::string& detail);
   std::vector<JointBreakEvent> break_events_;
 };
 

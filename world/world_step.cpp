@@ -272,7 +272,12 @@ void World::integrateVelocities(Real h) {
   for (size_t i = 0; i < bodies_.size(); ++i) {
     Body& b = bodies_[i];
     if (b.asleep) continue;
-    orientation_offset_[i] = integrateVelocity(b, gravity_, h, settings_.gyroscopic);
+    bool gyro_ok = true;
+    orientation_offset_[i] = integrateVelocity(b, gravity_, h, settings_.gyroscopic, &gyro_ok);
+    if (!gyro_ok)
+      diagnose(i, "gyroscopic solve",
+               "implicit-midpoint gyroscopic step not solved to 1e-10 |L| (h |w| = " +
+                   std::to_string(h * b.angular_velocity.norm()) + " rad): energy and |L| not conserved; substeps with h |w| < 1 restore it");
     // Safety net: cap the spin rate (off by default). stableNorm: |w|^2
     // must not overflow for the very spins the cap is there to catch.
     if (settings_.max_angular_velocity < kInf) {
@@ -280,6 +285,15 @@ void World::integrateVelocities(Real h) {
       if (w > settings_.max_angular_velocity) b.angular_velocity *= settings_.max_angular_velocity / w;
     }
   }
+}
+
+void World::diagnose(size_t body, const char* kind, const std::string& detail) {
+  for (Diagnostic& d : diagnostics_)
+    if (d.body.index == static_cast<std::int32_t>(body) && d.kind == kind) {
+      ++d.count;
+      return;
+    }
+  diagnostics_.push_back({BodyId{static_cast<std::int32_t>(body)}, bodies_[body].name, kind, detail, step_count_, 1});
 }
 
 void World::integratePositions(Real h) {

@@ -13,6 +13,22 @@ namespace {
 // there. `iterations` is the most sweeps a solve makes.
 constexpr Real kRoundOff = Real(1e-13);
 
+// What a sweep gathers as it goes: the largest impulse, and for NNCG each
+// row's change in this sweep (indexed like the rows) with their squared sum.
+struct SweepTally {
+  Real lambda_max = 0;
+  Real* change = nullptr;  // null: not gathered (plain PGS)
+  Real change_norm2 = 0;
+  const ConstraintRow* first = nullptr;  // rows[0], to index `change`
+  void add(const ConstraintRow& r, Real next, Real d) {
+    lambda_max = std::max(lambda_max, std::abs(next));
+    if (change) {
+      change[&r - first] = d;
+      change_norm2 += d * d;
+    }
+  }
+};
+
 inline Real rowVelocity(const ConstraintRow& r, const SolverBody& a, const SolverBody& b) {
   return r.j_lin_a.dot(a.v) + r.j_ang_a.dot(a.w) + r.j_lin_b.dot(b.v) + r.j_ang_b.dot(b.w);
 }
@@ -45,7 +61,7 @@ inline void rowBounds(const ConstraintRow& r, std::span<const ConstraintRow> row
 }
 
 inline Real solveRow(ConstraintRow& r, std::span<ConstraintRow> rows, std::span<SolverBody> bodies, Real sor,
-                     Real& lambda_max) {
+                     SweepTally& tally) {
   SolverBody& a = bodies[r.body_a];
   SolverBody& b = bodies[r.body_b];
   Real lo, hi;
@@ -55,7 +71,7 @@ inline Real solveRow(ConstraintRow& r, std::span<ConstraintRow> rows, std::span<
   const Real d = next - r.lambda;
   r.lambda = next;
   applyImpulse(r, a, b, d);
-  lambda_max = std::max(lambda_max, std::abs(next));
+  tally.add(r, next, d);
   return std::abs(d);
 }
 
@@ -90,7 +106,7 @@ inline void factorBlock(const Real* a_b, const ConstraintRow* r, int n, Real* l)
 // A_b until no row's velocity error exceeds 1e-9 of the largest, at most
 // 32; they cost a few flops each and touch no body.
 inline Real solveBlock(ConstraintRow* r, int n, const Real* a_b, const Real* l, std::span<SolverBody> bodies, Real sor,
-                       Real& lambda_max) {
+                       SweepTally& tally) {
   SolverBody& a = bodies[r[0].body_a];
   SolverBody& b = bodies[r[0].body_b];
   Real residual[4], lambda[4], delta[4] = {0, 0, 0, 0};
@@ -148,7 +164,7 @@ inline Real solveBlock(ConstraintRow* r, int n, const Real* a_b, const Real* l, 
     r[i].lambda = lambda[i];
     applyImpulse(r[i], a, b, delta[i]);
     max_delta = std::max(max_delta, std::abs(delta[i]));
-    lambda_max = std::max(lambda_max, std::abs(lambda[i]));
+    tally.add(r[i], lambda[i], delta[i]);
   }
   return max_delta;
 }
@@ -182,26 +198,26 @@ void buildUnits(std::span<const ConstraintRow> rows, bool blocks, PgsScratch& s)
 }
 
 inline Real solveUnit(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, const PgsScratch& s, size_t u,
-                      Real sor, Real& lambda_max) {
+                      Real sor, SweepTally& tally) {
   const std::int32_t begin = s.unit_begin[u], end = s.unit_begin[u + 1];
-  if (s.block_of[u] < 0) return solveRow(rows[static_cast<size_t>(begin)], rows, bodies, sor, lambda_max);
+  if (s.block_of[u] < 0) return solveRow(rows[static_cast<size_t>(begin)], rows, bodies, sor, tally);
   const int n = end - begin;
   const Real* a_b = &s.block[static_cast<size_t>(s.block_of[u])];
-  return solveBlock(&rows[static_cast<size_t>(begin)], n, a_b, a_b + n * n, bodies, sor, lambda_max);
+  return solveBlock(&rows[static_cast<size_t>(begin)], n, a_b, a_b + n * n, bodies, sor, tally);
 }
 
 // One sweep over the units, in order or shuffled; returns the largest change.
 inline Real sweep(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, const PgsSettings& s,
-                  PgsScratch& scratch, std::uint64_t& rng_state, Real& lambda_max) {
+                  PgsScratch& scratch, std::uint64_t& rng_state, SweepTally& tally) {
   Real max_delta = 0;
   const size_t units = scratch.block_of.size();
   if (s.randomize_order) {
     for (size_t i = units - 1; i > 0; --i)  // Fisher-Yates
       std::swap(scratch.order[i], scratch.order[nextRandom(rng_state) % (i + 1)]);
     for (std::int32_t u : scratch.order)
-      max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, static_cast<size_t>(u), s.sor, lambda_max));
+      max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, static_cast<size_t>(u), s.sor, tally));
   } else {
-    for (size_t u = 0; u < units; ++u) max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, u, s.sor, lambda_max));
+    for (size_t u = 0; u < units; ++u) max_delta = std::max(max_delta, solveUnit(rows, bodies, scratch, u, s.sor, tally));
   }
   return max_delta;
 }
@@ -215,17 +231,12 @@ inline Real sweep(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, c
 // Gauss-Seidel removes the error of a stiff chain (a stack, a heavy body on
 // a light one) one link per sweep; the momentum carries the correction the
 // sweeps keep making in the same direction (docs/constraints.md measures it).
-inline void momentumStep(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, PgsScratch& s, Real& prev_norm2) {
-  Real norm2 = 0;
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const Real d = rows[i].lambda - s.previous[i];
-    s.previous[i] = d;  // reused to hold d_k
-    norm2 += d * d;
-  }
+inline void momentumStep(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, PgsScratch& s, Real norm2,
+                         Real& prev_norm2) {
   const Real beta = prev_norm2 > 0 ? norm2 / prev_norm2 : Real(0);
   prev_norm2 = norm2;
   if (beta == 0 || beta > 1) {  // first sweep: p = d; beta > 1 (the sweeps stopped agreeing): restart, p = 0
-    for (size_t i = 0; i < rows.size(); ++i) s.direction[i] = beta == 0 ? s.previous[i] : Real(0);
+    for (size_t i = 0; i < rows.size(); ++i) s.direction[i] = beta == 0 ? s.change[i] : Real(0);
     return;
   }
   for (size_t i = 0; i < rows.size(); ++i) {
@@ -238,7 +249,7 @@ inline void momentumStep(std::span<ConstraintRow> rows, std::span<SolverBody> bo
       r.lambda = next;
       applyImpulse(r, bodies[r.body_a], bodies[r.body_b], d);
     }
-    s.direction[i] = beta * s.direction[i] + s.previous[i];
+    s.direction[i] = beta * s.direction[i] + s.change[i];
   }
 }
 
@@ -261,21 +272,22 @@ PgsStats solvePgs(std::span<ConstraintRow> rows, std::span<SolverBody> bodies, c
   }
   Real prev_norm2 = 0;
   if (s.nncg) {
-    scratch.previous.resize(rows.size());
+    scratch.change.resize(rows.size());
     scratch.direction.assign(rows.size(), Real(0));
   }
   for (int it = 0; it < s.iterations; ++it) {
-    if (s.nncg)
-      for (size_t i = 0; i < rows.size(); ++i) scratch.previous[i] = rows[i].lambda;
-    Real lambda_max = 0;
-    const Real max_delta = sweep(rows, bodies, s, scratch, rng_state, lambda_max);
+    SweepTally tally;
+    tally.first = rows.data();
+    if (s.nncg) tally.change = scratch.change.data();
+    const Real max_delta = sweep(rows, bodies, s, scratch, rng_state, tally);
+    const Real lambda_max = tally.lambda_max;
     stats.iterations = it + 1;
     stats.last_max_delta = max_delta;
     if (s.tolerance > 0 && max_delta <= s.tolerance) break;
     if (max_delta <= kRoundOff * lambda_max) break;  // a fixed point to round-off: more sweeps change nothing
     // No momentum after the last sweep: it would leave the rows unprojected
     // by a sweep (the result must be a PGS iterate).
-    if (s.nncg && it + 1 < s.iterations) momentumStep(rows, bodies, scratch, prev_norm2);
+    if (s.nncg && it + 1 < s.iterations) momentumStep(rows, bodies, scratch, tally.change_norm2, prev_norm2);
   }
   return stats;
 }

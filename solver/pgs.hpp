@@ -51,7 +51,7 @@ struct PgsScratch {
   std::vector<std::int32_t> block_of;    // per unit: offset of its block matrix in `block`, or -1
   std::vector<Real> block;               // blocks' A_b, n x n row-major (n <= 4), each followed by its Cholesky factor
   std::vector<std::int32_t> order;       // unit visiting order (randomized)
-  std::vector<Real> previous;            // NNCG: lambda before the sweep, then its change
+  std::vector<Real> change;              // NNCG: each row's impulse change in the last sweep
   std::vector<Real> direction;           // NNCG: the momentum direction p
 };
 

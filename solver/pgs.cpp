@@ -102,9 +102,10 @@ inline void factorBlock(const Real* a_b, const ConstraintRow* r, int n, Real* l)
 // bodies. First the case of every point pushing (a resting face): one
 // solve with the block's Cholesky factor, M delta = residual - cfm lambda,
 // accepted when every impulse stays >= 0 and the rows' velocity errors
-// vanish. Otherwise (a corner lifting, an impact) local projected sweeps on
-// A_b until no row's velocity error exceeds 1e-9 of the largest, at most
-// 32; they cost a few flops each and touch no body.
+// vanish (to 1e-6 of the largest velocity error the block started with).
+// Otherwise (a corner lifting, an impact) local projected sweeps on A_b
+// until no row's velocity error exceeds that, at most 32; they cost a few
+// flops each and touch no body.
 inline Real solveBlock(ConstraintRow* r, int n, const Real* a_b, const Real* l, std::span<SolverBody> bodies, Real sor,
                        SweepTally& tally) {
   SolverBody& a = bodies[r[0].body_a];

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <exception>
 
 namespace cairn::validation {
 
@@ -34,18 +36,61 @@ VaryAxis parseVary(const std::string& arg, const SceneDesc& scene) {
   if (!isSolverKey(axis.key))
     throw InputError("--vary", "", "unknown setting '" + axis.key + "' (known: " + solverKeyList() + ")");
   const std::string list = arg.substr(eq + 1);
-  size_t from = 0;
-  while (true) {
+  std::vector<std::string> texts;
+  for (size_t from = 0;;) {
     const size_t comma = list.find(',', from);
-    const std::string text = list.substr(from, comma == std::string::npos ? std::string::npos : comma - from);
-    if (text.empty()) throw InputError("--vary " + axis.key, "", "empty value in '" + arg + "'");
-    // Parsed and checked on a copy of the scene, then stored as the text
-    // that reads back to the same value ("1/60" -> 0.016666666666666666).
-    SceneDesc probe = scene;
-    setSolverKey(probe, axis.key, text, "--vary " + axis.key);
-    axis.values.push_back(solverKeyValue(probe, axis.key));
+    texts.push_back(list.substr(from, comma == std::string::npos ? std::string::npos : comma - from));
     if (comma == std::string::npos) break;
     from = comma + 1;
+  }
+  // Parsed and checked on a copy of the scene, then stored as the text that
+  // reads back to the same value ("1/60" -> 0.016666666666666666).
+  const auto canonical = [&](const std::string& text) {
+    if (text.empty()) throw InputError("--vary " + axis.key, "", "empty value in '" + arg + "'");
+    SceneDesc probe = scene;
+    setSolverKey(probe, axis.key, text, "--vary " + axis.key);
+    return solverKeyValue(probe, axis.key);
+  };
+  for (size_t t = 0; t < texts.size(); ++t) {
+    if (texts[t] != "...") {
+      axis.values.push_back(canonical(texts[t]));
+      continue;
+    }
+    // "a,b,...,z" or "a,b,c,...,z": the progression the values before it
+    // start, continued below z, then z. Geometric when three values share
+    // a ratio (the "1,2,4,...,200": 8 to 128, then 200), else
+    // arithmetic ("1,2,...,10", "0.1,0.2,...,0.6").
+    if (axis.values.size() < 2 || t + 2 != texts.size())
+      throw InputError("--vary " + axis.key, "",
+                       "'...' needs two values before it and one after it, at the end (got '" + arg + "')");
+    const std::string end_text = canonical(texts[t + 1]);
+    const size_t n = axis.values.size();
+    double a = 0, b = 0, z = 0, before = 0;
+    try {
+      a = std::stod(axis.values[n - 2]);
+      b = std::stod(axis.values[n - 1]);
+      z = std::stod(end_text);
+      before = n >= 3 ? std::stod(axis.values[n - 3]) : 0;
+    } catch (const std::exception&) {
+      throw InputError("--vary " + axis.key, "", "'...' continues numbers only (got '" + arg + "')");
+    }
+    if (!(b > a) || !(z > b))
+      throw InputError("--vary " + axis.key, "", "'...' needs increasing values before the end (got '" + arg + "')");
+    const bool integral = axis.values.back().find_first_of(".eE") == std::string::npos;
+    const auto same = [](double x, double y) { return std::abs(x - y) <= 1e-9 * std::max(std::abs(x), std::abs(y)); };
+    const bool geometric = n >= 3 && before > 0 && same(b / a, a / before);
+    if (n >= 3 && !geometric && !same(b - a, a - before))
+      throw InputError("--vary " + axis.key, "", "the values before '...' are not a progression (got '" + arg + "')");
+    for (int k = 1;; ++k) {
+      const double next = geometric ? b * std::pow(b / a, k) : b + k * (b - a);
+      if (!(next < z) || same(next, z)) break;
+      char buf[64];
+      std::snprintf(buf, sizeof buf, integral ? "%.0f" : "%.12g", integral ? std::round(next) : next);
+      axis.values.push_back(canonical(buf));
+      if (axis.values.size() > 10000) throw InputError("--vary " + axis.key, "", "'...' expands to over 10000 values");
+    }
+    axis.values.push_back(end_text);
+    break;
   }
   for (size_t i = 0; i < axis.values.size(); ++i)
     for (size_t k = 0; k < i; ++k)

@@ -26,7 +26,10 @@ struct VaryAxis {
   std::vector<std::string> values;  // canonical text (numbers round-trip exactly)
 };
 
-// "iterations=1,2,4" -> {iterations, {1, 2, 4}}, each value checked on
+// "iterations=1,2,4" -> {iterations, {1, 2, 4}}; "iterations=1,2,4,...,200"
+// -> {1, 2, 4, 8, 16, 32, 64, 128, 200} (the progression the values before
+// "..." start -- geometric when three share a ratio, else arithmetic --
+// continued below the last value, then the last value). Each value checked on
 // `scene` (validation/solver_keys.hpp). Throws InputError naming --vary and
 // the key or value.
 VaryAxis parseVary(const std::string& arg, const SceneDesc& scene);

@@ -4,6 +4,10 @@
 // option, nothing written), PGS approaching the exact LCP as iterations
 // grow, and the --method/--substeps/--iterations overrides of run and
 // validate. Each sweep is short (tens of steps) to keep the suite fast.
+#include "dynamics/error.hpp"
+#include "validation/standard_scenes.hpp"
+#include "validation/sweep_plan.hpp"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -184,6 +188,21 @@ void expectBadInput(const std::string& args, const std::string& names, const Tem
   EXPECT_EQ(r.status, 2) << args;
   EXPECT_NE(r.err.find(names), std::string::npos) << args << ": " << r.err;
   EXPECT_FALSE(fs::exists(tmp / "bad")) << args;
+}
+
+// The issue writes the iteration list as "1,2,4,...,200": "..." continues
+// the progression the values before it start (geometric when three share a
+// ratio, else arithmetic) below the last value, then takes the last value.
+TEST(Sweep, EllipsisContinuesTheProgression) {
+  const SceneDesc scene = validation::standardScene("hinge-pendulum-0.1").scene;
+  using V = std::vector<std::string>;
+  EXPECT_EQ(validation::parseVary("iterations=1,2,4,...,200", scene).values,
+            (V{"1", "2", "4", "8", "16", "32", "64", "128", "200"}));
+  EXPECT_EQ(validation::parseVary("iterations=1,2,...,5", scene).values, (V{"1", "2", "3", "4", "5"}));
+  EXPECT_EQ(validation::parseVary("erp=0.1,0.2,...,0.5", scene).values, (V{"0.1", "0.2", "0.3", "0.4", "0.5"}));
+  for (const char* bad : {"iterations=1,2,5,...,50", "iterations=1,...,50", "iterations=1,2,...", "method=pgs,direct,...,lcp",
+                          "iterations=4,2,...,1"})
+    EXPECT_THROW((void)validation::parseVary(bad, scene), InputError) << bad;
 }
 
 TEST(Sweep, BadVaryAndShardExitTwoNamingTheOption) {

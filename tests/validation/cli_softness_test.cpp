@@ -1,46 +1,23 @@
 // `cairn softness` run as a process: the numbers it prints against the
 // closed forms of constraints/softness.hpp, and bad input rejected with one
 // line on stderr and exit status 2.
+#include "cli_test_helpers.hpp"
+
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 namespace {
 
-struct CliResult {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using cairn::test::CliResult;
 
 CliResult softness(const std::string& args) {
-  static int counter = 0;
-  const auto dir = std::filesystem::temp_directory_path();
-  const std::string stem = "cairn_softness_" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
-  const auto out = dir / (stem + ".out"), err = dir / (stem + ".err");
-  const std::string cmd = std::string(CAIRN_CLI) + " softness " + args + " >" + out.string() + " 2>" + err.string();
-  const int raw = std::system(cmd.c_str());
-  CliResult r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  std::filesystem::remove(out);
-  std::filesystem::remove(err);
-  return r;
+  const cairn::test::TempDir tmp("cairn_softness");
+  return cairn::test::runCairn("softness " + args, tmp);
 }
 
 // The `name = value ...` lines of the report.

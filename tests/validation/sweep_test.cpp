@@ -4,13 +4,12 @@
 // option, nothing written), PGS approaching the exact LCP as iterations
 // grow, and the --method/--substeps/--iterations overrides of run and
 // validate. Each sweep is short (tens of steps) to keep the suite fast.
+#include "cli_test_helpers.hpp"
 #include "dynamics/error.hpp"
 #include "validation/standard_scenes.hpp"
 #include "validation/sweep_plan.hpp"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -26,44 +25,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using test::CliResult;
+using test::slurp;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() / ("cairn_sweep_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string operator/(const std::string& name) const { return (path / name).string(); }
+struct TempDir : test::TempDir {
+  TempDir() : test::TempDir("cairn_sweep") {}
 };
 
-struct CliResult {
-  int status = -1;
-  std::string out, err;
-};
-
-CliResult cairn(const std::string& args, const TempDir& tmp) {
-  const fs::path out = tmp.path / "stdout.txt", err = tmp.path / "stderr.txt";
-  const std::string cmd = "cd " + std::string(CAIRN_SOURCE_DIR) + " && " + std::string(CAIRN_CLI) + " " + args + " >" +
-                          out.string() + " 2>" + err.string();
-  const int raw = std::system(cmd.c_str());
-  CliResult r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+CliResult cairn(const std::string& args, const TempDir& tmp) { return test::runCairn(args, tmp); }
 
 // sweep.csv as rows of column -> cell.
 using Row = std::map<std::string, std::string>;

@@ -2,6 +2,7 @@
 // comparison logic on trajectories with a known difference, the hinge
 // pendulum in cairn against Bullet, the report files, and bad input
 // (exit status 2 with one line naming the path).
+#include "cli_test_helpers.hpp"
 #include "dynamics/error.hpp"
 #include "validation/compare.hpp"
 #include "validation/report.hpp"
@@ -10,11 +11,8 @@
 #include "world/scene_json.hpp"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -25,43 +23,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using test::CliResult;
+using test::slurp;
 
-// A fresh directory under the system temp dir, removed at the end.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() / ("cairn_validate_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
+struct TempDir : test::TempDir {
+  TempDir() : test::TempDir("cairn_validate") {}
 };
 
-struct CliResult {
-  int status = -1;
-  std::string out, err;
-};
-
-CliResult cairn(const std::string& args, const TempDir& tmp) {
-  const fs::path out = tmp.path / "stdout.txt", err = tmp.path / "stderr.txt";
-  const std::string cmd = std::string(CAIRN_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int raw = std::system(cmd.c_str());
-  CliResult r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+CliResult cairn(const std::string& args, const TempDir& tmp) { return test::runCairn(args, tmp); }
 
 int lineCount(const std::string& s) {
   int n = 0;

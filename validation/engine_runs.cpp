@@ -271,8 +271,8 @@ void runEngines(SceneResult& r) {
     SceneDesc exact = r.scene;
     exact.solver.method = SolverMethod::Direct;
     CairnRunner reference(exact, r.spec, r.reference);
-    for (int s = 1; s <= r.scene.steps && reference.step(s); ++s) {
-    }
+    for (int s = 1; s <= r.scene.steps; ++s)
+      if (!reference.step(s)) break;
   }
 }
 

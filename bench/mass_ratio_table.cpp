@@ -23,7 +23,7 @@
 #include "solver/lcp_residual.hpp"
 #include "solver/pgs.hpp"
 #include "validation/bullet_oracle.hpp"
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 #include "world/world.hpp"
 
 #include <algorithm>

@@ -9,7 +9,7 @@
 //   cairn_bench --benchmark_filter=BM_StepVsBullet
 #include "validation/bullet_oracle.hpp"
 #include "validation/standard_scenes.hpp"
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 #include "world/world.hpp"
 
 #include <benchmark/benchmark.h>

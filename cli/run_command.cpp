@@ -3,7 +3,7 @@
 //  [--iterations N]`: simulate a scene and write its trajectory.
 #include "cli/commands.hpp"
 #include "cli/solver_overrides.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "world/scene_json.hpp"
 #include "world/world.hpp"
 

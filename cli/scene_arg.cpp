@@ -1,6 +1,6 @@
 #include "cli/scene_arg.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/compare.hpp"
 #include "validation/standard_scenes.hpp"
 #include "world/scene_json.hpp"

@@ -3,7 +3,7 @@
 // slash or a .json ending that does not exist is a missing file, not a key.
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <string>
 

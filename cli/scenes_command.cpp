@@ -4,7 +4,7 @@
 // command's output. `cairn scenes --list` prints the keys.
 // Exit status 2 when DIR cannot be created or written.
 #include "cli/commands.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/scene_writer.hpp"
 #include "validation/standard_scenes.hpp"
 

@@ -4,7 +4,7 @@
 // the same table as `cairn sweep --vary` (validation/solver_keys.hpp).
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -15,7 +15,7 @@
 // naming it and nothing written.
 #include "cli/commands.hpp"
 #include "cli/scene_arg.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/plot_script.hpp"
 #include "validation/report.hpp"
 #include "validation/scene_writer.hpp"

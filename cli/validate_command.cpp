@@ -14,7 +14,7 @@
 #include "cli/commands.hpp"
 #include "cli/scene_arg.hpp"
 #include "cli/solver_overrides.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/compare.hpp"
 #include "validation/plot_script.hpp"
 #include "validation/report.hpp"

@@ -16,8 +16,8 @@
 //             keeps such shapes out of its tree.
 #pragma once
 
-#include "collision/shape.hpp"
-#include "dynamics/math.hpp"
+#include "cairn/shape.hpp"
+#include "cairn/math.hpp"
 
 #include <algorithm>
 

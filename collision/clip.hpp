@@ -14,7 +14,7 @@
 // a polygon running along reference side plane j has label 64 + j.
 #pragma once
 
-#include "dynamics/math.hpp"
+#include "cairn/math.hpp"
 
 #include <cstdint>
 

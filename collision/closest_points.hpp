@@ -10,7 +10,7 @@
 // Parallel segments (a e - b^2 ~ 0) take s = 0 and continue the same way.
 #pragma once
 
-#include "dynamics/math.hpp"
+#include "cairn/math.hpp"
 
 namespace cairn {
 

@@ -6,8 +6,8 @@
 // polygon, used for mesh triangles (a triangle is a hull with no thickness).
 #pragma once
 
-#include "collision/shape.hpp"
-#include "dynamics/math.hpp"
+#include "cairn/shape.hpp"
+#include "cairn/math.hpp"
 
 #include <cstdint>
 

@@ -19,7 +19,7 @@
 //   - the unique edges, as (min, max) vertex index pairs of the loops.
 #include "collision/hull.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>

@@ -1,7 +1,7 @@
 // Convex hulls from point clouds (qhull, Debian's libqhull-dev).
 #pragma once
 
-#include "collision/shape.hpp"
+#include "cairn/shape.hpp"
 
 #include <memory>
 #include <string>

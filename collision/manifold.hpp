@@ -18,8 +18,8 @@
 // Plane-plane, plane-mesh and mesh-mesh produce nothing (static geometry).
 #pragma once
 
-#include "collision/shape.hpp"
-#include "dynamics/math.hpp"
+#include "cairn/shape.hpp"
+#include "cairn/math.hpp"
 
 #include <cstdint>
 #include <vector>

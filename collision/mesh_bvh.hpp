@@ -9,7 +9,7 @@
 #pragma once
 
 #include "collision/aabb.hpp"
-#include "collision/shape.hpp"
+#include "cairn/shape.hpp"
 
 namespace cairn {
 

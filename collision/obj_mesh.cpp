@@ -14,7 +14,7 @@
 #include "collision/obj_mesh.hpp"
 
 #include "collision/mesh_bvh.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 #include <cerrno>
 #include <cstdlib>

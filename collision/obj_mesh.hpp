@@ -1,7 +1,7 @@
 // Wavefront OBJ loading for static triangle meshes (level geometry).
 #pragma once
 
-#include "collision/shape.hpp"
+#include "cairn/shape.hpp"
 
 #include <memory>
 #include <string>

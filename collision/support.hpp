@@ -18,8 +18,8 @@
 //   hull      the vertex maximizing d.v (linear scan: hulls are small)
 #pragma once
 
-#include "collision/shape.hpp"
-#include "dynamics/math.hpp"
+#include "cairn/shape.hpp"
+#include "cairn/math.hpp"
 
 namespace cairn {
 

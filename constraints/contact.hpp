@@ -19,7 +19,7 @@
 #pragma once
 
 #include "constraints/parts.hpp"
-#include "world/defs.hpp"
+#include "cairn/defs.hpp"
 
 #include <cstdint>
 

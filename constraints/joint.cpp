@@ -1,6 +1,6 @@
 #include "constraints/joint.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 #include <cmath>
 

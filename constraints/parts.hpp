@@ -12,7 +12,7 @@
 
 #include "constraints/row.hpp"
 #include "constraints/softness.hpp"
-#include "world/defs.hpp"
+#include "cairn/defs.hpp"
 
 #include <vector>
 

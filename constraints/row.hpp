@@ -24,7 +24,8 @@
 // PGS inner loop is a dot product, a clamp and two axpy's.
 #pragma once
 
-#include "dynamics/math.hpp"
+#include "cairn/math.hpp"
+#include "cairn/settings.hpp"
 
 #include <cstdint>
 
@@ -42,16 +43,6 @@ enum class RowKind : std::uint8_t {
 };
 inline constexpr int kRowKindCount = static_cast<int>(RowKind::Count);
 const char* rowKindName(RowKind k);
-
-// Where a row's position feedback -ERP/h C goes (settings.hpp explains the
-// choice). InRhs is ODE's single pass; the other two solve it in a second
-// pass from zero impulses, so warm starting carries only the impulse that
-// holds the constraint, never last step's correction.
-enum class Correction : std::uint8_t {
-  InRhs,           // in rhs with the velocity target (ODE quickstep)
-  VelocityBias,    // second pass, result added to the velocities (Baumgarte)
-  PseudoVelocity   // second pass, result moves positions only (split impulse)
-};
 
 struct ConstraintRow {
   std::int32_t body_a = 0, body_b = 0;  // solver body indices (0 = the world)

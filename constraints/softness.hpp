@@ -15,8 +15,8 @@
 // so the row's diagonal gains CFM / h (constraints/row.hpp).
 #pragma once
 
-#include "dynamics/math.hpp"
-#include "world/defs.hpp"
+#include "cairn/math.hpp"
+#include "cairn/defs.hpp"
 
 namespace cairn {
 

@@ -11,36 +11,14 @@
 // contacts and joints see.
 #pragma once
 
-#include "collision/shape.hpp"
-#include "dynamics/math.hpp"
+#include "cairn/defs.hpp"
+#include "cairn/math.hpp"
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace cairn {
-
-enum class BodyType { Static, Kinematic, Dynamic };
-
-const char* bodyTypeName(BodyType t);
-
-// How the gyroscopic torque -w x (J w) enters the velocity update
-// (docs/dynamics.md compares them on a tumbling box).
-enum class Gyroscopic {
-  Off,             // ignored: w' = J^-1 tau only
-  Explicit,        // forward Euler on the world-frame term (gains energy)
-  ImplicitEuler,   // backward Euler in the body frame, one Newton step
-                   // (Bullet's default: stable but dissipative)
-  ImplicitMidpoint // midpoint rule on the body-frame Euler equations with
-                   // the orientation advanced at the midpoint velocity:
-                   // conserves kinetic energy and L of a free body (default)
-};
-
-// How the orientation quaternion follows the angular velocity.
-enum class OrientationIntegrator {
-  ExponentialMap,  // q <- exp(h w) q, exact for constant w (default)
-  Derivative       // q <- normalize(q + h/2 w q), section 12.6.4's first method
-};
 
 struct Body {
   std::string name;

@@ -4,6 +4,7 @@
 // q' = 1/2 w q (section 12.6.4).
 #pragma once
 
+#include "cairn/settings.hpp"
 #include "dynamics/body.hpp"
 
 namespace cairn {

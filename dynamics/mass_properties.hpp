@@ -14,8 +14,8 @@
 // parallel axis theorem: I += m (|d|^2 E - d d^T).
 #pragma once
 
-#include "collision/shape.hpp"
-#include "dynamics/math.hpp"
+#include "cairn/shape.hpp"
+#include "cairn/math.hpp"
 
 #include <vector>
 

@@ -5,7 +5,7 @@
 // enters J v.
 #pragma once
 
-#include "dynamics/math.hpp"
+#include "cairn/math.hpp"
 
 namespace cairn {
 

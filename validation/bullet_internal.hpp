@@ -7,8 +7,8 @@
 #pragma once
 
 #include "validation/bullet_oracle.hpp"
-#include "world/defs.hpp"
-#include "world/settings.hpp"
+#include "cairn/defs.hpp"
+#include "cairn/settings.hpp"
 
 #include <btBulletDynamicsCommon.h>
 

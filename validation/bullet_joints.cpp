@@ -27,7 +27,7 @@
 // not). With match_cairn every row's CFM is rewritten by CairnCfm<>.
 #include "validation/bullet_internal.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 #include <BulletDynamics/ConstraintSolver/btFixedConstraint.h>
 #include <BulletDynamics/ConstraintSolver/btGeneric6DofSpring2Constraint.h>

@@ -19,7 +19,7 @@
 // after the step the pose is advanced exactly as cairn advances it.
 #include "validation/bullet_oracle.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/bullet_internal.hpp"
 #include "world/world.hpp"
 

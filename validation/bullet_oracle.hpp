@@ -16,8 +16,8 @@
 // the two frames is undone in state().
 #pragma once
 
-#include "dynamics/math.hpp"
-#include "world/scene.hpp"
+#include "cairn/math.hpp"
+#include "cairn/scene.hpp"
 
 #include <memory>
 #include <string>

@@ -3,7 +3,7 @@
 // measuring them is in engine_runs.cpp.
 #include "validation/compare.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 #include <algorithm>
 #include <cmath>

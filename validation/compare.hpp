@@ -25,7 +25,7 @@
 // to read the report").
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 #include "world/world.hpp"
 
 #include <nlohmann/json.hpp>

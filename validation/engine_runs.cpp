@@ -2,7 +2,7 @@
 // code (compare.hpp): Bullet's states are copied into a shadow cairn World
 // after every step and measured there.
 #include "collision/manifold.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/bullet_oracle.hpp"
 #include "validation/compare.hpp"
 #include "world/world.hpp"

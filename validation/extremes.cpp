@@ -1,6 +1,6 @@
 #include "validation/extremes.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/bullet_oracle.hpp"
 #include "validation/scenarios.hpp"
 #include "world/world.hpp"

@@ -20,7 +20,7 @@
 // and tests/long/extremes_test.cpp.
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <functional>
 #include <string>

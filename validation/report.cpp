@@ -1,6 +1,6 @@
 #include "validation/report.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/plot_script.hpp"
 
 #include <nlohmann/json.hpp>

@@ -1,6 +1,6 @@
 #include "validation/scenarios.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 #include <cmath>
 

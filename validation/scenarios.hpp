@@ -7,7 +7,7 @@
 // sleeping, 1 m cubes of mass 1 unless stated.
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <string>
 #include <vector>

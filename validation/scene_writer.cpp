@@ -1,6 +1,6 @@
 #include "validation/scene_writer.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 #include <algorithm>
 #include <cmath>

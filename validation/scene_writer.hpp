@@ -14,7 +14,7 @@
 // path it was loaded from (ShapeDesc::source), which must still exist.
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,6 +1,6 @@
 #include "validation/solver_keys.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "world/world.hpp"
 
 #include <algorithm>

@@ -9,7 +9,7 @@
 // an InputError naming the command-line option, the key and the value.
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <string>
 #include <vector>

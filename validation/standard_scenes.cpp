@@ -1,6 +1,6 @@
 #include "validation/standard_scenes.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/compare.hpp"
 #include "validation/scenarios.hpp"
 

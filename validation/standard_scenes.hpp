@@ -8,7 +8,7 @@
 // asks (cairn's default is on).
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <string>
 #include <vector>

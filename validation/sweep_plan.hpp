@@ -14,7 +14,7 @@
 // A shard i/n (0 <= i < n) runs the jobs whose index % n == i.
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <string>
 #include <vector>

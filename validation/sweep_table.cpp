@@ -1,6 +1,6 @@
 #include "validation/sweep_table.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/solver_keys.hpp"
 
 #include <algorithm>

@@ -1,5 +1,5 @@
-#include "dynamics/error.hpp"
-#include "world/scene.hpp"
+#include "cairn/error.hpp"
+#include "cairn/scene.hpp"
 #include "world/scene_json.hpp"
 #include "world/world.hpp"
 

@@ -2,7 +2,7 @@
 
 #include "collision/hull.hpp"
 #include "collision/obj_mesh.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 #include <nlohmann/json.hpp>
 

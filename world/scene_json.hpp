@@ -1,7 +1,7 @@
 // The JSON scene format (docs/scene-format.md) to and from SceneDesc.
 #pragma once
 
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 
 #include <string>
 

@@ -1,6 +1,6 @@
 #include "world/world.hpp"
 
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "dynamics/forces.hpp"
 #include "dynamics/mass_properties.hpp"
 

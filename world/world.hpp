@@ -12,8 +12,8 @@
 #include "solver/direct_solver.hpp"
 #include "solver/pgs.hpp"
 #include "solver/solver_body.hpp"
-#include "world/defs.hpp"
-#include "world/settings.hpp"
+#include "cairn/defs.hpp"
+#include "cairn/settings.hpp"
 
 #include <functional>
 #include <string>

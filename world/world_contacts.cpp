@@ -1,7 +1,7 @@
 // Stage 3 of the step: broadphase -> filtering -> narrowphase -> contact
 // cache (warm-start impulses matched by feature id) -> callback -> events.
 #include "collision/aabb.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "world/world.hpp"
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 // Joint creation, lookup and feedback (the World's side of constraints/).
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "world/world.hpp"
 
 namespace cairn {

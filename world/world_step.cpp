@@ -18,7 +18,7 @@
 // A guard after each stage stops the step for an island in which anything
 // went non-finite (its bodies go back to the step's start, at rest) and lets
 // the other islands step on (docs/extremes.md, "Safety nets").
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "dynamics/forces.hpp"
 #include "dynamics/integrate.hpp"
 #include "solver/lcp_exact.hpp"

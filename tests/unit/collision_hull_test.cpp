@@ -1,6 +1,6 @@
 // Convex hull construction (qhull) and its invariants.
 #include "collision/hull.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "dynamics/mass_properties.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // Wavefront OBJ loading: the subset cairn reads and the errors it reports.
 #include "collision/obj_mesh.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 
 #include <gtest/gtest.h>
 

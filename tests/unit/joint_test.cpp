@@ -1,7 +1,7 @@
 // Joints, limits, motors, softness and breaking against closed forms and
 // invariants.
 #include "constraints/softness.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "test_helpers.hpp"
 
 #include <gtest/gtest.h>

@@ -5,9 +5,9 @@
 //   - max_correction_velocity caps the position feedback of rigid joint
 //     rows as it caps contact push-out;
 //   - max_angular_velocity caps a body's spin (off by default).
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "test_helpers.hpp"
-#include "world/scene.hpp"
+#include "cairn/scene.hpp"
 #include "world/scene_json.hpp"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // Scene files: a valid scene loads; each bad input of the foundation and
 // constraint issues is rejected with a message naming the file, the object
 // and the field, and the C++ API leaves the world unchanged.
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "test_helpers.hpp"
 #include "world/scene_json.hpp"
 

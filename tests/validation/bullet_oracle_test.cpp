@@ -3,7 +3,7 @@
 // contact, pendulum period, the settings mapping) — with every tolerance
 // explained by Bullet's own behaviour.
 #include "collision/hull.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/bullet_oracle.hpp"
 #include "validation/scenarios.hpp"
 #include "world/world.hpp"

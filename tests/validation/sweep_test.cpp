@@ -5,7 +5,7 @@
 // grow, and the --method/--substeps/--iterations overrides of run and
 // validate. Each sweep is short (tens of steps) to keep the suite fast.
 #include "cli_test_helpers.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/standard_scenes.hpp"
 #include "validation/sweep_plan.hpp"
 

@@ -3,7 +3,7 @@
 // pendulum in cairn against Bullet, the report files, and bad input
 // (exit status 2 with one line naming the path).
 #include "cli_test_helpers.hpp"
-#include "dynamics/error.hpp"
+#include "cairn/error.hpp"
 #include "validation/compare.hpp"
 #include "validation/report.hpp"
 #include "validation/scene_writer.hpp"

@@ -3,8 +3,8 @@
 // validation, a Bullet world (validation/bullet_oracle.hpp).
 #pragma once
 
-#include "world/defs.hpp"
-#include "world/settings.hpp"
+#include "cairn/defs.hpp"
+#include "cairn/settings.hpp"
 
 #include <string>
 #include <vector>

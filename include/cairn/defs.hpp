@@ -3,8 +3,7 @@
 // definition completely before it changes anything.
 #pragma once
 
-#include "collision/shape.hpp"
-#include "dynamics/body.hpp"
+#include "cairn/shape.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -12,6 +11,10 @@
 #include <vector>
 
 namespace cairn {
+
+enum class BodyType { Static, Kinematic, Dynamic };
+
+const char* bodyTypeName(BodyType t);
 
 // Small integer handles into the World's arrays (never pointers).
 struct BodyId {

@@ -3,13 +3,39 @@
 // these under "solver" (docs/scene-format.md).
 #pragma once
 
-#include "constraints/row.hpp"
-#include "dynamics/body.hpp"
-#include "dynamics/math.hpp"
+#include "cairn/math.hpp"
 
 #include <cstdint>
 
 namespace cairn {
+
+// Where a row's position feedback -ERP/h C goes (settings.hpp explains the
+// choice). InRhs is ODE's single pass; the other two solve it in a second
+// pass from zero impulses, so warm starting carries only the impulse that
+// holds the constraint, never last step's correction.
+enum class Correction : std::uint8_t {
+  InRhs,           // in rhs with the velocity target (ODE quickstep)
+  VelocityBias,    // second pass, result added to the velocities (Baumgarte)
+  PseudoVelocity   // second pass, result moves positions only (split impulse)
+};
+
+// How the gyroscopic torque -w x (J w) enters the velocity update
+// (docs/dynamics.md compares them on a tumbling box).
+enum class Gyroscopic {
+  Off,             // ignored: w' = J^-1 tau only
+  Explicit,        // forward Euler on the world-frame term (gains energy)
+  ImplicitEuler,   // backward Euler in the body frame, one Newton step
+                   // (Bullet's default: stable but dissipative)
+  ImplicitMidpoint // midpoint rule on the body-frame Euler equations with
+                   // the orientation advanced at the midpoint velocity:
+                   // conserves kinetic energy and L of a free body (default)
+};
+
+// How the orientation quaternion follows the angular velocity.
+enum class OrientationIntegrator {
+  ExponentialMap,  // q <- exp(h w) q, exact for constant w (default)
+  Derivative       // q <- normalize(q + h/2 w q), section 12.6.4's first method
+};
 
 enum class SolverMethod { PGS, Direct, LCP };
 

@@ -13,7 +13,7 @@
 //   mesh     {triangles}            static triangle mesh (TriangleMeshData)
 #pragma once
 
-#include "dynamics/math.hpp"
+#include "cairn/math.hpp"
 
 #include <array>
 #include <memory>

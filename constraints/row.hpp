@@ -26,23 +26,11 @@
 
 #include "cairn/math.hpp"
 #include "cairn/settings.hpp"
+#include "cairn/stats.hpp"
 
 #include <cstdint>
 
 namespace cairn {
-
-enum class RowKind : std::uint8_t {
-  JointLinear,   // positional rows of joints (anchors coincide, slider axes)
-  JointAngular,  // angular rows of joints (hinge axes, fixed orientation)
-  Limit,         // joint limits (unilateral)
-  Motor,         // velocity motors (bounded by max force)
-  ContactNormal,
-  ContactFriction,
-  ContactRolling,
-  Count
-};
-inline constexpr int kRowKindCount = static_cast<int>(RowKind::Count);
-const char* rowKindName(RowKind k);
 
 struct ConstraintRow {
   std::int32_t body_a = 0, body_b = 0;  // solver body indices (0 = the world)

@@ -14,6 +14,7 @@
 #include "solver/solver_body.hpp"
 #include "cairn/defs.hpp"
 #include "cairn/settings.hpp"
+#include "cairn/stats.hpp"
 
 #include <functional>
 #include <string>
@@ -25,20 +26,6 @@ struct Spring {
   SpringDef def;
   Vec3 local_a, local_b;  // anchors in the body frames (world points for the world)
   Real rest_length;
-};
-
-// What a step reports about itself (the solver's quality, MuJoCo-style).
-struct StepStats {
-  int iterations = 0;      // PGS sweeps done (summed over substeps)
-  Real residual = 0;       // natural-map LCP residual after the solve (max norm, last substep)
-  int rows = 0;            // rows solved (last substep)
-  int contacts = 0;        // touching manifolds
-  int contact_points = 0;
-  int islands = 0;         // awake islands solved
-  int sleeping_bodies = 0;
-  Real max_penetration = 0;  // deepest contact after the step (m)
-  int rows_by_kind[kRowKindCount] = {};
-  double wall_seconds = 0;
 };
 
 // A joint that broke: its force or torque exceeded its threshold.

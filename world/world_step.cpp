@@ -33,35 +33,71 @@
 
 namespace cairn {
 
+namespace {
+
+// Wall time of each stage, added into StepStats::stage_seconds: one clock
+// read per stage boundary.
+class StageClock {
+ public:
+  explicit StageClock(StepStats& stats) : stats_(stats), last_(std::chrono::steady_clock::now()) {}
+  void lap(Stage s) {
+    const auto now = std::chrono::steady_clock::now();
+    stats_.stage_seconds[static_cast<int>(s)] += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  StepStats& stats_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+}  // namespace
+
 void World::step(Real h) {
   if (!std::isfinite(h) || h <= 0)
     throw InputError("world", "dt", "time step must be positive and finite (got " + std::to_string(h) + ")");
   const auto t0 = std::chrono::steady_clock::now();
+  stats_ = StepStats{};
+  StageClock clock(stats_);
   saveStepStart();
   break_events_.clear();
   contact_events_.clear();
-  stats_ = StepStats{};
+  clock.lap(Stage::Guards);
 
   const int n = settings_.substeps;
   const Real hs = h / n;
   applyExternalForces();                                  // 1
+  clock.lap(Stage::Forces);
   detectContacts(h);                                      // 2
+  clock.lap(Stage::Collide);
   buildIslands();                                         // 3
   frozen_island_.assign(static_cast<size_t>(island_count_), 0);
   any_frozen_ = false;
+  clock.lap(Stage::Islands);
   for (int sub = 0; sub < n; ++sub) {
     integrateVelocities(hs);                              // 4
+    clock.lap(Stage::Integrate);
     guardBodies("velocity integration");
+    clock.lap(Stage::Guards);
     buildRows(hs);                                        // 5
+    clock.lap(Stage::BuildRows);
     guardRows("row building");
+    clock.lap(Stage::Guards);
     solveRows();                                          // 6 (guards each island's rows after its solve)
+    clock.lap(Stage::Solve);
     guardBodies("constraint solve");
+    clock.lap(Stage::Guards);
     integratePositions(hs);                               // 7
+    clock.lap(Stage::Integrate);
     guardBodies("position integration");
+    clock.lap(Stage::Guards);
     storeImpulses(hs);                                    // 8
+    clock.lap(Stage::Store);
   }
   emitContactEvents(old_contacts_);                       // 9
+  clock.lap(Stage::Events);
   updateSleep(h);
+  clock.lap(Stage::Sleep);
   clearAccumulators();
   saveStepEnd();
 
@@ -72,6 +108,7 @@ void World::step(Real h) {
   }
   stats_.islands = island_count_;
   stats_.max_penetration = maxPenetration();
+  clock.lap(Stage::Guards);
   ++step_count_;
   time_ += h;
   stats_.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

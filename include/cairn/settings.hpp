@@ -52,6 +52,7 @@ struct SolverSettings {
   bool nncg = true;             // PGS with NNCG momentum between sweeps (solver/pgs.cpp); false: plain PGS as Bullet
   std::uint64_t seed = 1;
   int substeps = 1;             // sub-steps per step
+  int threads = 1;              // worker threads for the step (results are bit-identical for any count)
 
   // ODE-style softness: rows drive J v toward -ERP/h C, CFM softens them.
   Real erp = Real(0.2);

@@ -12,7 +12,7 @@
 //   cairn_bench --table chain-whip
 #include "validation/bullet_oracle.hpp"
 #include "validation/scenarios.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -40,10 +40,10 @@ WhipResult runCairn(const SceneDesc& scene) {
   for (int s = 0; s < scene.steps; ++s) {
     w.step(scene.dt);
     double now = 0;
-    for (int j = 0; j < w.jointCount(); ++j) now = std::max(now, double(w.jointError(JointId{j}).linear));
+    for (int j = 0; j < cairn::detail::internals(w).jointSlots(); ++j) now = std::max(now, double(w.jointError(JointId{j}).linear));
     r.worst = std::max(r.worst, now);
     r.end = now;
-    r.tip_speed = std::max(r.tip_speed, double(w.bodies().back().linear_velocity.norm()));
+    r.tip_speed = std::max(r.tip_speed, double(cairn::detail::internals(w).bodies().back().linear_velocity.norm()));
   }
   return r;
 }

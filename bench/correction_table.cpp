@@ -8,7 +8,7 @@
 //
 //   cairn_bench --table correction
 #include "validation/scenarios.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -31,7 +31,7 @@ CorrectionResult run(SceneDesc scene, Correction c, int iterations) {
   for (int s = 0; s < scene.steps; ++s) {
     w.step(scene.dt);
     double now = 0;
-    for (int j = 0; j < w.jointCount(); ++j) now = std::max(now, double(w.jointError(JointId{j}).linear));
+    for (int j = 0; j < cairn::detail::internals(w).jointSlots(); ++j) now = std::max(now, double(w.jointError(JointId{j}).linear));
     r.worst = std::max(r.worst, now);
     if (w.time() >= 3) r.worst_after_3s = std::max(r.worst_after_3s, now);
     r.end = now;

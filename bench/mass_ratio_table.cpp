@@ -24,7 +24,7 @@
 #include "solver/pgs.hpp"
 #include "validation/bullet_oracle.hpp"
 #include "cairn/scene.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -90,7 +90,7 @@ RunResult simulate(const SceneDesc& scene) {
   RunResult r;
   for (int s = 0; s < scene.steps; ++s) {
     w.step(scene.dt);
-    track(r, w.body(BodyId{0}).position, w.jointError(JointId{0}).linear);
+    track(r, cairn::detail::internals(w).body(BodyId{0}).position, w.jointError(JointId{0}).linear);
   }
   return r;
 }
@@ -119,13 +119,13 @@ StepLcp stepLcp(const Case& c) {
   scene.solver.position_correction = Correction::InRhs;
   World w = buildWorld(scene);
   for (int s = 0; s < scene.steps; ++s) {
-    const std::vector<Real> warm = w.joint(JointId{0}).warm;
+    const std::vector<Real> warm = cairn::detail::internals(w).joint(JointId{0}).warm;
     w.step(scene.dt);
     const bool impact = w.lastStepStats().rows_by_kind[static_cast<int>(RowKind::Limit)] > 0;
     if (c.limit ? !impact : s != 29) continue;
     StepLcp p;
-    p.rows = w.rows();
-    const Body& b = w.body(BodyId{0});
+    p.rows = cairn::detail::internals(w).expandedRows();
+    const Body& b = cairn::detail::internals(w).body(BodyId{0});
     p.v_star = {SolverBody{}, SolverBody{b.linear_velocity, b.angular_velocity}};
     for (ConstraintRow& r : p.rows) {
       p.v_star[1].v -= r.m_lin_b * r.lambda;

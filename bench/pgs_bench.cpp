@@ -12,7 +12,7 @@
 //                    position-correction pass, integration, feedback)
 #include "solver/pgs.hpp"
 #include "validation/scenarios.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -37,10 +37,10 @@ PgsProblem capture(const SceneDesc& scene, int warm_steps) {
   World w = buildWorld(scene);
   for (int s = 0; s < warm_steps; ++s) w.step(scene.dt);
   PgsProblem p;
-  p.rows = w.rows();
+  p.rows = cairn::detail::internals(w).expandedRows();
   p.bodies.resize(static_cast<size_t>(w.bodyCount()) + 1);
   for (int i = 0; i < w.bodyCount(); ++i) {
-    const Body& b = w.bodies()[static_cast<size_t>(i)];
+    const Body& b = cairn::detail::internals(w).bodies()[static_cast<size_t>(i)];
     const Vec3 dv = b.isDynamic() ? Vec3(scene.dt * w.gravity()) : Vec3::Zero();
     p.bodies[static_cast<size_t>(i) + 1] = SolverBody{b.linear_velocity + dv, b.angular_velocity};
   }

@@ -10,7 +10,7 @@
 #include "validation/bullet_oracle.hpp"
 #include "validation/standard_scenes.hpp"
 #include "cairn/scene.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -5,7 +5,7 @@
 #include "cli/solver_overrides.hpp"
 #include "cairn/error.hpp"
 #include "world/scene_json.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -54,7 +54,7 @@ struct RunFigures {
     residual_max = std::max(residual_max, st.residual);
     rows_max = std::max(rows_max, st.rows);
     for (int k = 0; k < kRowKindCount; ++k) rows_by_kind_max[k] = std::max(rows_by_kind_max[k], st.rows_by_kind[k]);
-    for (int j = 0; j < w.jointCount(); ++j) {
+    for (int j = 0; j < cairn::detail::internals(w).jointSlots(); ++j) {
       const JointError e = w.jointError(JointId{j});
       joint_linear_max = std::max(joint_linear_max, e.linear);
       joint_angular_max = std::max(joint_angular_max, e.angular);
@@ -73,7 +73,7 @@ struct RunFigures {
     nlohmann::json kinds = nlohmann::json::object();
     for (int k = 0; k < kRowKindCount; ++k) kinds[rowKindName(static_cast<RowKind>(k))] = rows_by_kind_max[k];
     m["rows_by_kind_max"] = kinds;
-    m["joint_count"] = w.jointCount();
+    m["joint_count"] = cairn::detail::internals(w).jointSlots();
     m["joint_error_linear_max_m"] = joint_linear_max;
     m["joint_error_angular_max_rad"] = joint_angular_max;
     m["joints_broken"] = broken;
@@ -92,7 +92,7 @@ void putNumber(std::string& line, double v) {
 }
 
 void appendRows(std::string& out, const World& w, int step) {
-  for (const Body& b : w.bodies()) {
+  for (const Body& b : cairn::detail::internals(w).bodies()) {
     if (b.type == BodyType::Static) continue;
     std::string line;
     line += std::to_string(step);

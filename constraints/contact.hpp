@@ -32,6 +32,7 @@ struct ContactPointState {
   Real depth = 0;                // at detection (> 0 penetrating)
   Real approach_speed = 0;       // relative normal velocity at detection (< 0 approaching)
   Real normal_impulse = 0;       // accumulated, carried for warm starting
+  Real max_impulse = 0;          // the largest normal impulse of this step's substeps (restitution acts only where > 0)
   Vec3 friction_impulse = Vec3::Zero();  // accumulated tangential impulse, world vector
   std::int32_t normal_row = -1;  // this (sub)step's row index
   std::int32_t friction_row = -1;  // first of two

@@ -15,9 +15,9 @@ ConstraintRow makeRow(const BodyView& a, const BodyView& b, const Vec3& lin, con
   r.j_ang_a = -ra.cross(lin);
   r.j_lin_b = lin;
   r.j_ang_b = rb.cross(lin);
-  r.m_lin_a = a.inv_mass * r.j_lin_a;
+  r.m_lin_a = a.inv_mass * a.lin_factor.cwiseProduct(r.j_lin_a);
   r.m_ang_a = a.inv_inertia * r.j_ang_a;
-  r.m_lin_b = b.inv_mass * r.j_lin_b;
+  r.m_lin_b = b.inv_mass * b.lin_factor.cwiseProduct(r.j_lin_b);
   r.m_ang_b = b.inv_inertia * r.j_ang_b;
   const Real diag = r.j_lin_a.dot(r.m_lin_a) + r.j_ang_a.dot(r.m_ang_a) + r.j_lin_b.dot(r.m_lin_b) +
                     r.j_ang_b.dot(r.m_ang_b);

@@ -20,6 +20,7 @@
 
 #include "constraints/parts.hpp"
 #include "cairn/defs.hpp"
+#include "cairn/events.hpp"
 
 #include <array>
 #include <string>
@@ -29,14 +30,11 @@ namespace cairn {
 
 inline constexpr int kMaxJointRows = 7;
 
-struct JointFeedback {
-  Vec3 force_a = Vec3::Zero(), torque_a = Vec3::Zero();  // on body a, torque about its center of mass
-  Vec3 force_b = Vec3::Zero(), torque_b = Vec3::Zero();  // on body b
-};
-
 struct Joint {
   JointDef def;
   bool broken = false;
+  bool alive = true;             // false: a free slot (destroyed joint)
+  std::uint32_t generation = 0;  // of the slot
 
   // Frames in body coordinates (relative to the center of mass); for the
   // world they are world coordinates.
@@ -68,13 +66,6 @@ struct JointRowSettings {
 void buildJointRows(const Joint& j, const BodyView& a, const BodyView& b, RowContext& ctx,
                     const JointRowSettings& settings);
 
-// Position error of the joint now: the largest anchor separation (m) of its
-// positional rows and the largest angle error (rad) of its angular rows
-// (limits count only when violated).
-struct JointError {
-  Real linear = 0;
-  Real angular = 0;
-};
 JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& b);
 
 // Per-type row builders (one file each).

@@ -34,9 +34,9 @@ int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, cons
   r.j_ang_a = ang_a;
   r.j_lin_b = lin_b;
   r.j_ang_b = ang_b;
-  r.m_lin_a = a.inv_mass * lin_a;
+  r.m_lin_a = a.inv_mass * a.lin_factor.cwiseProduct(lin_a);
   r.m_ang_a = a.inv_inertia * ang_a;
-  r.m_lin_b = b.inv_mass * lin_b;
+  r.m_lin_b = b.inv_mass * b.lin_factor.cwiseProduct(lin_b);
   r.m_ang_b = b.inv_inertia * ang_b;
   const Real diag = lin_a.dot(r.m_lin_a) + ang_a.dot(r.m_ang_a) + lin_b.dot(r.m_lin_b) + ang_b.dot(r.m_ang_b);
   if (!(diag > Real(1e-300))) return -1;  // neither body can move along this row

@@ -26,7 +26,8 @@ struct BodyView {
   Quat q = Quat::Identity();
   Mat3 rot = Mat3::Identity();
   Real inv_mass = 0;
-  Mat3 inv_inertia = Mat3::Zero();  // world frame
+  Vec3 lin_factor = Vec3::Ones();   // 0 on world axes the body's translation is locked along
+  Mat3 inv_inertia = Mat3::Zero();  // world frame (projected when rotations are locked)
   Vec3 v = Vec3::Zero(), w = Vec3::Zero();
 };
 

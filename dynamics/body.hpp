@@ -14,7 +14,9 @@
 #include "cairn/defs.hpp"
 #include "cairn/math.hpp"
 
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,8 @@ namespace cairn {
 struct Body {
   std::string name;
   BodyType type = BodyType::Dynamic;
+  bool alive = true;             // false: a free slot (destroyed body)
+  std::uint32_t generation = 0;  // of the slot: advances when the body is destroyed
 
   // Primary state.
   Vec3 position = Vec3::Zero();  // center of mass, world frame
@@ -35,14 +39,28 @@ struct Body {
   Real inv_mass = 0;
   Mat3 inertia_body = Mat3::Zero();      // about the center of mass
   Mat3 inv_inertia_body = Mat3::Zero();
+  Vec3 com_local = Vec3::Zero();         // center of mass in the body frame of the definition
+
+  // Degrees of freedom locked through the mass matrix (BodyDef's
+  // lock_translation and lock_rotation): 1 per free world axis, 0 per
+  // locked one; and the projector I - sum a a^T onto the rotations allowed.
+  Vec3 linear_factor = Vec3::Ones();
+  Mat3 rotation_projector = Mat3::Identity();
+  bool rotation_locked = false;
 
   // Derived.
   Mat3 rotation = Mat3::Identity();
-  Mat3 inv_inertia_world = Mat3::Zero();
+  Mat3 inv_inertia_world = Mat3::Zero();  // R J^-1 R^T, projected when rotations are locked
 
   // Working variables.
   Vec3 force = Vec3::Zero();
   Vec3 torque = Vec3::Zero();
+
+  // External loads from the definition (world frame).
+  Vec3 constant_force = Vec3::Zero();
+  Vec3 constant_torque = Vec3::Zero();
+  std::vector<BodyDef::TimedImpulse> impulses;  // by time
+  std::size_t next_impulse = 0;
 
   // Material and damping.
   Real friction = Real(0.5);
@@ -59,20 +77,35 @@ struct Body {
 
   // Sleeping (world/islands.cpp).
   bool asleep = false;
+  bool sleeping_allowed = true;
   Real sleep_timer = 0;  // seconds spent below the sleep thresholds
 
-  // Shapes in the body frame: positions relative to the center of mass.
+  // Shapes in the body frame: positions relative to the center of mass;
+  // shape_ids[i] is the world's shape slot of shapes[i].
   std::vector<ShapeDesc> shapes;
+  std::vector<std::int32_t> shape_ids;
+
+  // How the mass was defined, to recompute it when shapes or the type change.
+  std::optional<Real> def_mass, def_density;
+  std::optional<Mat3> def_inertia;
 
   bool isDynamic() const { return type == BodyType::Dynamic; }
 
   Transform transform() const { return Transform{position, orientation}; }
+  // The frame BodyDef::position and orientation placed (the center of mass
+  // sits at com_local in it).
+  Transform originTransform() const { return Transform{position - orientation * com_local, orientation}; }
 
   // Refresh R and R J^-1 R^T from the orientation.
   void updateDerived() {
     rotation = orientation.toRotationMatrix();
     inv_inertia_world = rotation * inv_inertia_body * rotation.transpose();
+    if (rotation_locked) inv_inertia_world = rotation_projector * inv_inertia_world * rotation_projector;
   }
+
+  // The velocity the locks allow (their components removed).
+  Vec3 allowedLinear(const Vec3& v) const { return v.cwiseProduct(linear_factor); }
+  Vec3 allowedAngular(const Vec3& w) const { return rotation_locked ? Vec3(rotation_projector * w) : w; }
 
   Vec3 velocityAt(const Vec3& world_point) const {
     return linear_velocity + angular_velocity.cross(world_point - position);

@@ -9,7 +9,7 @@ void applyForceAtPoint(Body& b, const Vec3& force, const Vec3& world_point) {
 
 void applyImpulseAtPoint(Body& b, const Vec3& impulse, const Vec3& world_point) {
   if (!b.isDynamic()) return;
-  b.linear_velocity += b.inv_mass * impulse;
+  b.linear_velocity += b.allowedLinear(b.inv_mass * impulse);
   b.angular_velocity += b.inv_inertia_world * (world_point - b.position).cross(impulse);
 }
 

@@ -85,7 +85,10 @@ Vec3 gyroscopicImplicitMidpoint(const Mat3& inertia, const Vec3& w0, Real h, boo
 
 Vec3 integrateVelocity(Body& b, const Vec3& gravity, Real h, Gyroscopic gyro, bool* gyro_converged) {
   if (!b.isDynamic()) return Vec3::Zero();
-  b.linear_velocity += h * (gravity + b.inv_mass * b.force);
+  // Degree-of-freedom locks: the projected inverse mass (linear_factor) and
+  // inverse inertia (already projected in inv_inertia_world) keep every
+  // acceleration off the locked axes, gravity included.
+  b.linear_velocity += h * b.allowedLinear(gravity + b.inv_mass * b.force);
   b.angular_velocity += h * (b.inv_inertia_world * b.torque);
 
   Vec3 orientation_offset = Vec3::Zero();
@@ -117,6 +120,13 @@ Vec3 integrateVelocity(Body& b, const Vec3& gravity, Real h, Gyroscopic gyro, bo
       orientation_offset = b.rotation * wbm - b.angular_velocity;
       break;
     }
+  }
+
+  if (b.rotation_locked) {
+    // The gyroscopic term couples the axes; its part along a locked axis is
+    // taken by the lock (the projection is the lock's reaction).
+    b.angular_velocity = b.allowedAngular(b.angular_velocity);
+    orientation_offset = b.allowedAngular(orientation_offset);
   }
 
   // Linear damping as an implicit decay, stable for any h c.

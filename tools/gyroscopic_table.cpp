@@ -1,6 +1,6 @@
 // Prints the table of docs/dynamics.md: what each gyroscopic treatment does
 // to a torque-free tumbling body. Run: ./build/tools/gyroscopic_table
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -25,13 +25,13 @@ Row tumble(Gyroscopic g, const Mat3& inertia, const Vec3& w0, Real h, Real secon
   d.inertia = inertia;
   d.angular_velocity = w0;
   const BodyId id = w.createBody(d);
-  const Real e0 = w.body(id).kineticEnergy();
-  const Vec3 l0 = w.body(id).angularMomentum();
+  const Real e0 = cairn::detail::internals(w).body(id).kineticEnergy();
+  const Vec3 l0 = cairn::detail::internals(w).body(id).angularMomentum();
   Row r{1, 0, 0, 0, 0};
   Real prev = 1;
   for (int k = 0; k < static_cast<int>(std::lround(seconds / h)); ++k) {
     w.step(h);
-    const Body& b = w.body(id);
+    const Body& b = cairn::detail::internals(w).body(id);
     const Vec3 l = b.angularMomentum();
     r.max_energy_err = std::max(r.max_energy_err, std::abs(b.kineticEnergy() / e0 - 1));
     r.max_l_err = std::max(r.max_l_err, std::abs(l.norm() / l0.norm() - 1));
@@ -40,7 +40,7 @@ Row tumble(Gyroscopic g, const Mat3& inertia, const Vec3& w0, Real h, Real secon
     if ((y > 0) != (prev > 0)) ++r.flips;
     prev = y;
   }
-  r.energy_ratio = w.body(id).kineticEnergy() / e0;
+  r.energy_ratio = cairn::detail::internals(w).body(id).kineticEnergy() / e0;
   return r;
 }
 

@@ -21,7 +21,7 @@
 
 #include "cairn/error.hpp"
 #include "validation/bullet_internal.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -492,7 +492,7 @@ BulletOracle::BulletOracle(const SceneDesc& scene, const OracleOptions& options)
   m.configureSolver();
 
   for (size_t i = 0; i < scene.bodies.size(); ++i)
-    m.addBody(reference.bodies()[i], scene.bodies[i], static_cast<int>(i));
+    m.addBody(cairn::detail::internals(reference).bodies()[i], scene.bodies[i], static_cast<int>(i));
   for (const JointDef& j : scene.joints) {
     JointDef d = j;
     if (d.name.empty()) d.name = "joint" + std::to_string(m.joints.size());

@@ -26,7 +26,7 @@
 #pragma once
 
 #include "cairn/scene.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -5,7 +5,7 @@
 #include "cairn/error.hpp"
 #include "validation/bullet_oracle.hpp"
 #include "validation/compare.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -57,7 +57,7 @@ struct ShapeEntry {
 
 double geometricPenetration(const World& world, const std::vector<std::uint64_t>& joined) {
   std::vector<ShapeEntry> finite, infinite;
-  const auto& bodies = world.bodies();
+  const auto& bodies = cairn::detail::internals(world).bodies();
   for (size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
     for (size_t k = 0; k < b.shapes.size(); ++k) {
@@ -118,7 +118,7 @@ Recorder::Recorder(const SceneDesc& scene, const ValidationSpec& spec) : spec_(s
 }
 
 void Recorder::record(const World& world, double time, double step_seconds, EngineRun& run) {
-  const auto& bodies = world.bodies();
+  const auto& bodies = cairn::detail::internals(world).bodies();
   if (!started_) {
     for (const Body& b : bodies) {
       start_position_.push_back(b.position);
@@ -148,7 +148,7 @@ void Recorder::record(const World& world, double time, double step_seconds, Engi
   run.energy.push_back(world.kineticEnergy() + world.potentialEnergy());
   run.momentum.push_back(world.linearMomentum());
   double jl = 0, ja = 0;
-  for (int j = 0; j < world.jointCount(); ++j) {
+  for (int j = 0; j < cairn::detail::internals(world).jointSlots(); ++j) {
     const JointError e = world.jointError(JointId{j});
     jl = std::max(jl, double(e.linear));
     ja = std::max(ja, double(e.angular));
@@ -156,10 +156,10 @@ void Recorder::record(const World& world, double time, double step_seconds, Engi
   run.joint_error.push_back(jl);
   run.joint_error_angular.push_back(ja);
   if (contacts_possible_) run.penetration.push_back(geometricPenetration(world, joined_));
-  if (!world.springs().empty()) {
-    const Spring& s = world.springs().front();
-    const Vec3 pa = s.def.body_a.isWorld() ? s.local_a : world.body(s.def.body_a).transform().apply(s.local_a);
-    const Vec3 pb = s.def.body_b.isWorld() ? s.local_b : world.body(s.def.body_b).transform().apply(s.local_b);
+  if (!cairn::detail::internals(world).springs().empty()) {
+    const Spring& s = cairn::detail::internals(world).springs().front();
+    const Vec3 pa = s.def.body_a.isWorld() ? s.local_a : cairn::detail::internals(world).body(s.def.body_a).transform().apply(s.local_a);
+    const Vec3 pb = s.def.body_b.isWorld() ? s.local_b : cairn::detail::internals(world).body(s.def.body_b).transform().apply(s.local_b);
     run.spring_length.push_back((pb - pa).norm());
   }
   for (size_t t = 0; t < spec_.traces.size(); ++t) {
@@ -196,7 +196,7 @@ bool finiteState(const OracleBodyState& s) {
 // Bullet's states into the shadow World; false if any is not finite.
 bool copyStates(const BulletOracle& oracle, World& shadow) {
   for (int i = 0; i < shadow.bodyCount(); ++i) {
-    Body& b = shadow.body(BodyId{i});
+    Body& b = cairn::detail::internals(shadow).body(BodyId{i});
     if (b.type == BodyType::Static) continue;
     const OracleBodyState s = oracle.state(i);
     if (!finiteState(s)) return false;
@@ -206,8 +206,8 @@ bool copyStates(const BulletOracle& oracle, World& shadow) {
     b.angular_velocity = s.angular_velocity;
     b.updateDerived();
   }
-  for (int j = 0; j < shadow.jointCount(); ++j)
-    if (!oracle.jointActive(j) && !shadow.joint(JointId{j}).broken) shadow.removeJoint(JointId{j});
+  for (int j = 0; j < cairn::detail::internals(shadow).jointSlots(); ++j)
+    if (!oracle.jointActive(j) && !cairn::detail::internals(shadow).joint(JointId{j}).broken) cairn::detail::internals(shadow).removeJoint(JointId{j});
   return true;
 }
 

@@ -3,7 +3,7 @@
 #include "cairn/error.hpp"
 #include "validation/bullet_oracle.hpp"
 #include "validation/scenarios.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -103,7 +103,7 @@ struct Tracker {
     Real ymin = kInf, ymax = -kInf;
     double ke0 = 0, pe = 0;
     for (int i = 0; i < w.bodyCount(); ++i) {
-      const Body& b = w.body(BodyId{i});
+      const Body& b = cairn::detail::internals(w).body(BodyId{i});
       mass.push_back({b.isDynamic() ? b.mass : 0, b.inertia_body});
       start.push_back(b.position);
       if (!b.isDynamic()) continue;
@@ -412,13 +412,13 @@ ExtremeResult runCairn(const ExtremeCase& c, const SolverSettings& settings) {
     t.record(
         w.bodyCount(),
         [&](int i, Vec3& x, Quat& q, Vec3& v, Vec3& om) {
-          const Body& b = w.body(BodyId{i});
+          const Body& b = cairn::detail::internals(w).body(BodyId{i});
           x = b.position;
           q = b.orientation;
           v = b.linear_velocity;
           om = b.angular_velocity;
         },
-        w.jointCount(), [&](int j) { return w.jointError(JointId{j}).linear; });
+        cairn::detail::internals(w).jointSlots(), [&](int j) { return w.jointError(JointId{j}).linear; });
     if (!t.r.finite) break;  // cannot happen while the guard works: recorded, not hidden
   }
   t.r.numerical_events = static_cast<int>(w.numericalEvents().size());

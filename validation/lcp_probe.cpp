@@ -55,11 +55,11 @@ double kineticNorm(const std::vector<ConstraintRow>& rows, size_t body_count, Im
 
 }  // namespace
 
-void ExactLcpProbe::beforeStep(const World& world) { before_ = world.bodies(); }
+void ExactLcpProbe::beforeStep(const World& world) { before_ = cairn::detail::internals(world).bodies(); }
 
 std::optional<ExactLcpProbe::Distance> ExactLcpProbe::afterStep(const World& world, Real h) {
-  const std::vector<ConstraintRow>& rows = world.rows();
-  const std::vector<Body>& bodies = world.bodies();
+  const std::vector<ConstraintRow>& rows = cairn::detail::internals(world).expandedRows();
+  const std::vector<Body>& bodies = cairn::detail::internals(world).bodies();
   why_.clear();
   if (rows.empty()) {
     why_ = "the step solved no rows";
@@ -89,7 +89,7 @@ std::optional<ExactLcpProbe::Distance> ExactLcpProbe::afterStep(const World& wor
       why_ = "PGS's Baumgarte pass with several substeps: v* of the last substep is not recoverable";
       return std::nullopt;
     }
-    if (!world.springs().empty()) {
+    if (!cairn::detail::internals(world).springs().empty()) {
       why_ = "springs add forces inside the step";
       return std::nullopt;
     }

@@ -38,7 +38,7 @@
 #pragma once
 
 #include "dynamics/body.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <optional>
 #include <string>

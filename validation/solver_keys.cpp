@@ -1,7 +1,7 @@
 #include "validation/solver_keys.hpp"
 
 #include "cairn/error.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <algorithm>
 #include <charconv>

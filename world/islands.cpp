@@ -1,15 +1,19 @@
 // Islands and sleeping.
 //
-// Awake dynamic bodies linked by touching contacts or joints form islands
+// Awake dynamic bodies linked by contacts or joints form islands
 // (union-find); static and kinematic bodies never link islands, so a floor
-// under two separate stacks keeps them apart. Rows are built and solved
-// island by island. An island whose bodies all stay below the sleep speeds
-// for sleep_time sleeps: its bodies stop integrating, its contacts keep
-// their cached state and make no rows, until something awake touches it or
-// the API wakes it.
-#include "world/world.hpp"
+// under two separate stacks keeps them apart. Each island is solved on its
+// own terms (its own stopping test and NNCG momentum in the PGS graph, or
+// its own direct or exact solve). An island whose bodies all stay below the
+// sleep speeds for sleep_time, and that is not being pushed out of a
+// penetration, sleeps: its bodies stop integrating, its contacts keep their
+// cached state and make no rows, until something awake touches it or the
+// API wakes it.
+#include "world/step_stages.hpp"
 
-namespace cairn {
+#include <algorithm>
+
+namespace cairn::detail {
 
 namespace {
 
@@ -29,11 +33,16 @@ void unite(std::vector<std::int32_t>& parent, std::int32_t a, std::int32_t b) {
   else parent[static_cast<size_t>(a)] = b;
 }
 
+bool kinematicMoving(const Body& b) {
+  return b.type == BodyType::Kinematic && b.linear_velocity.squaredNorm() + b.angular_velocity.squaredNorm() > 0;
+}
+
 }  // namespace
 
-void World::wakeIsland(std::int32_t island) {
+void WorldImpl::wakeIsland(std::int32_t island) {
+  if (island < 0) return;
   for (size_t i = 0; i < bodies_.size(); ++i) {
-    if (bodies_[i].asleep && sleep_island_[i] == island) {
+    if (bodies_[i].alive && bodies_[i].asleep && sleep_island_[i] == island) {
       bodies_[i].asleep = false;
       bodies_[i].sleep_timer = 0;
       sleep_island_[i] = -1;
@@ -41,105 +50,151 @@ void World::wakeIsland(std::int32_t island) {
   }
 }
 
-void World::wakeBody(BodyId id) {
+void WorldImpl::wakeBody(BodyId id) {
   Body& b = body(id);
   b.sleep_timer = 0;
   if (b.asleep) wakeIsland(sleep_island_[static_cast<size_t>(id.index)]);
 }
 
-void World::buildIslands() {
-  const auto n = static_cast<std::int32_t>(bodies_.size());
-  const auto movable = [&](BodyId id) { return !id.isWorld() && body(id).isDynamic(); };
+void buildIslands(WorldImpl& w, StepContext& ctx) {
+  const auto n = static_cast<std::int32_t>(w.bodies_.size());
+  const auto movable = [&](BodyId id) { return !id.isWorld() && w.body(id).isDynamic(); };
   const auto moving = [&](BodyId id) {
     if (id.isWorld()) return false;
-    const Body& b = body(id);
-    if (b.type == BodyType::Kinematic) return b.linear_velocity.squaredNorm() + b.angular_velocity.squaredNorm() > 0;
-    return b.isDynamic() && !b.asleep;
+    const Body& b = w.body(id);
+    return kinematicMoving(b) || (b.isDynamic() && !b.asleep);
   };
-  // Wake sleeping islands touched by something that moves.
-  for (const Contact& c : contacts_) {
+  // Wake sleeping islands touched by something that moves: gather the
+  // islands first, then wake them in one pass over the bodies.
+  std::vector<std::int32_t>& to_wake = ctx.wake_list;
+  to_wake.clear();
+  const auto touch = [&](BodyId sleeper, BodyId other) {
+    if (sleeper.isWorld() || !w.body(sleeper).asleep || !moving(other)) return;
+    w.body(sleeper).sleep_timer = 0;
+    to_wake.push_back(w.sleep_island_[static_cast<size_t>(sleeper.index)]);
+  };
+  for (const Contact& c : w.contacts_) {
     if (!c.enabled) continue;
-    const bool sa = !c.body_a.isWorld() && body(c.body_a).asleep, sb = !c.body_b.isWorld() && body(c.body_b).asleep;
-    if (sa && moving(c.body_b)) wakeBody(c.body_a);
-    if (sb && moving(c.body_a)) wakeBody(c.body_b);
+    touch(c.body_a, c.body_b);
+    touch(c.body_b, c.body_a);
   }
-  for (const Joint& j : joints_) {
-    if (j.broken) continue;
-    if (!j.def.body_a.isWorld() && body(j.def.body_a).asleep && moving(j.def.body_b)) wakeBody(j.def.body_a);
-    if (!j.def.body_b.isWorld() && body(j.def.body_b).asleep && moving(j.def.body_a)) wakeBody(j.def.body_b);
+  for (const Joint& j : w.joints_) {
+    if (!j.alive || j.broken) continue;
+    touch(j.def.body_a, j.def.body_b);
+    touch(j.def.body_b, j.def.body_a);
+  }
+  if (!to_wake.empty()) {
+    std::sort(to_wake.begin(), to_wake.end());
+    for (size_t i = 0; i < w.bodies_.size(); ++i) {
+      Body& b = w.bodies_[i];
+      if (!b.alive || !b.asleep || !std::binary_search(to_wake.begin(), to_wake.end(), w.sleep_island_[i])) continue;
+      b.asleep = false;
+      b.sleep_timer = 0;
+      w.sleep_island_[i] = -1;
+    }
   }
 
-  uf_parent_.resize(static_cast<size_t>(n));
-  for (std::int32_t i = 0; i < n; ++i) uf_parent_[static_cast<size_t>(i)] = i;
-  for (const Contact& c : contacts_)
-    if (c.enabled && movable(c.body_a) && movable(c.body_b)) unite(uf_parent_, c.body_a.index, c.body_b.index);
-  for (const Joint& j : joints_)
-    if (!j.broken && movable(j.def.body_a) && movable(j.def.body_b)) unite(uf_parent_, j.def.body_a.index, j.def.body_b.index);
+  ctx.uf_parent.resize(static_cast<size_t>(n));
+  for (std::int32_t i = 0; i < n; ++i) ctx.uf_parent[static_cast<size_t>(i)] = i;
+  for (const Contact& c : w.contacts_)
+    if (c.enabled && movable(c.body_a) && movable(c.body_b)) unite(ctx.uf_parent, c.body_a.index, c.body_b.index);
+  for (const Joint& j : w.joints_)
+    if (j.alive && !j.broken && movable(j.def.body_a) && movable(j.def.body_b))
+      unite(ctx.uf_parent, j.def.body_a.index, j.def.body_b.index);
 
   // Number the islands of awake dynamic bodies in body order.
-  body_island_.assign(static_cast<size_t>(n), -1);
-  std::vector<std::int32_t> roots(static_cast<size_t>(n));
-  for (std::int32_t i = 0; i < n; ++i) roots[static_cast<size_t>(i)] = findRoot(uf_parent_, i);
-  std::vector<std::int32_t> island_of_root(static_cast<size_t>(n), -1);
-  island_count_ = 0;
+  ctx.body_island.assign(static_cast<size_t>(n), -1);
+  std::vector<std::int32_t>& island_of_root = ctx.island_root;
+  island_of_root.assign(static_cast<size_t>(n), -1);
+  ctx.island_count = 0;
   for (std::int32_t i = 0; i < n; ++i) {
-    const Body& b = bodies_[static_cast<size_t>(i)];
-    if (!b.isDynamic() || b.asleep) continue;
-    std::int32_t& isl = island_of_root[static_cast<size_t>(roots[static_cast<size_t>(i)])];
-    if (isl < 0) isl = island_count_++;
-    body_island_[static_cast<size_t>(i)] = isl;
+    const Body& b = w.bodies_[static_cast<size_t>(i)];
+    if (!b.alive || !b.isDynamic() || b.asleep) continue;
+    std::int32_t& isl = island_of_root[static_cast<size_t>(findRoot(ctx.uf_parent, i))];
+    if (isl < 0) isl = ctx.island_count++;
+    ctx.body_island[static_cast<size_t>(i)] = isl;
   }
+  ctx.island_method.assign(static_cast<size_t>(ctx.island_count), w.settings_.method);
 }
 
-void World::updateSleep(Real h) {
+void updateSleep(WorldImpl& w, StepContext& ctx) {
+  const SolverSettings& s = w.settings_;
   int sleeping = 0;
-  if (!settings_.sleeping) {
-    for (auto& b : bodies_) b.sleep_timer = 0;
+  if (!s.sleeping) {
+    for (Body& b : w.bodies_) b.sleep_timer = 0;
   } else {
     // Each island sleeps as a whole, when its most restless body has been
     // slow for sleep_time.
-    std::vector<Real> island_min(static_cast<size_t>(island_count_), kInf);
-    const Real lin2 = settings_.sleep_linear_velocity * settings_.sleep_linear_velocity;
-    const Real ang2 = settings_.sleep_angular_velocity * settings_.sleep_angular_velocity;
-    for (size_t i = 0; i < bodies_.size(); ++i) {
-      Body& b = bodies_[i];
-      const std::int32_t isl = body_island_[i];
+    std::vector<Real>& island_min = ctx.island_min;
+    island_min.assign(static_cast<size_t>(ctx.island_count), kInf);
+    const Real lin2 = s.sleep_linear_velocity * s.sleep_linear_velocity;
+    const Real ang2 = s.sleep_angular_velocity * s.sleep_angular_velocity;
+    for (size_t i = 0; i < w.bodies_.size(); ++i) {
+      Body& b = w.bodies_[i];
+      const std::int32_t isl = ctx.body_island[i];
       if (isl < 0) continue;
-      if (b.linear_velocity.squaredNorm() > lin2 || b.angular_velocity.squaredNorm() > ang2) b.sleep_timer = 0;
-      else b.sleep_timer += h;
+      if (!b.sleeping_allowed || b.linear_velocity.squaredNorm() > lin2 || b.angular_velocity.squaredNorm() > ang2)
+        b.sleep_timer = 0;
+      else
+        b.sleep_timer += ctx.h;
       island_min[static_cast<size_t>(isl)] = std::min(island_min[static_cast<size_t>(isl)], b.sleep_timer);
     }
+    // An island being pushed out of a penetration deeper than the slop
+    // stays awake until the push-out is done: asleep it would keep the
+    // penetration for good.
+    for (size_t isl = 0; isl < ctx.island_pushing.size() && isl < island_min.size(); ++isl)
+      if (ctx.island_pushing[isl]) island_min[isl] = 0;
     // An island touching a moving kinematic body stays awake.
-    for (const Contact& c : contacts_) {
+    for (const Contact& c : w.contacts_) {
       for (const auto& [kin, dyn] : {std::pair{c.body_a, c.body_b}, std::pair{c.body_b, c.body_a}}) {
-        if (kin.isWorld() || dyn.isWorld() || body(kin).type != BodyType::Kinematic) continue;
-        const std::int32_t isl = body_island_[static_cast<size_t>(dyn.index)];
-        if (isl >= 0 && body(kin).linear_velocity.squaredNorm() + body(kin).angular_velocity.squaredNorm() > 0)
-          island_min[static_cast<size_t>(isl)] = 0;
+        if (kin.isWorld() || dyn.isWorld() || !kinematicMoving(w.body(kin))) continue;
+        const std::int32_t isl = ctx.body_island[static_cast<size_t>(dyn.index)];
+        if (isl >= 0) island_min[static_cast<size_t>(isl)] = 0;
       }
-    }
-    for (size_t i = 0; i < bodies_.size(); ++i) {
-      const std::int32_t isl = body_island_[i];
-      if (isl < 0 || island_min[static_cast<size_t>(isl)] < settings_.sleep_time) continue;
-      Body& b = bodies_[i];
-      b.asleep = true;
-      b.linear_velocity.setZero();
-      b.angular_velocity.setZero();
     }
     // A sleeping island is remembered by its first body's index, so waking
     // any of its bodies wakes all of them.
-    std::vector<std::int32_t> first(static_cast<size_t>(island_count_), -1);
-    for (size_t i = 0; i < bodies_.size(); ++i) {
-      const std::int32_t isl = body_island_[i];
-      if (isl >= 0 && bodies_[i].asleep && first[static_cast<size_t>(isl)] < 0) first[static_cast<size_t>(isl)] = static_cast<std::int32_t>(i);
-    }
-    for (size_t i = 0; i < bodies_.size(); ++i) {
-      const std::int32_t isl = body_island_[i];
-      if (isl >= 0 && bodies_[i].asleep) sleep_island_[i] = first[static_cast<size_t>(isl)];
+    std::vector<std::int32_t>& first = ctx.sleep_first;
+    first.assign(static_cast<size_t>(ctx.island_count), -1);
+    for (size_t i = 0; i < w.bodies_.size(); ++i) {
+      const std::int32_t isl = ctx.body_island[i];
+      if (isl < 0 || island_min[static_cast<size_t>(isl)] < s.sleep_time) continue;
+      Body& b = w.bodies_[i];
+      b.asleep = true;
+      b.linear_velocity.setZero();
+      b.angular_velocity.setZero();
+      if (first[static_cast<size_t>(isl)] < 0) first[static_cast<size_t>(isl)] = static_cast<std::int32_t>(i);
+      w.sleep_island_[i] = first[static_cast<size_t>(isl)];
     }
   }
-  for (const auto& b : bodies_) sleeping += b.asleep ? 1 : 0;
-  stats_.sleeping_bodies = sleeping;
+  for (const Body& b : w.bodies_) sleeping += (b.alive && b.asleep) ? 1 : 0;
+  w.stats_.sleeping_bodies = sleeping;
 }
 
-}  // namespace cairn
+void WorldImpl::putIslandToSleep(BodyId id) {
+  // The body's island as the last step grouped it (or the body alone when
+  // it was in none): every awake dynamic body of it stops now.
+  const std::int32_t isl =
+      static_cast<size_t>(id.index) < ctx_.body_island.size() ? ctx_.body_island[static_cast<size_t>(id.index)] : -1;
+  const auto sleep = [&](size_t i, std::int32_t first) {
+    Body& b = bodies_[i];
+    b.asleep = true;
+    b.linear_velocity.setZero();
+    b.angular_velocity.setZero();
+    b.sleep_timer = settings_.sleep_time;
+    sleep_island_[i] = first;
+  };
+  if (!body(id).isDynamic()) return;
+  if (isl < 0) {
+    sleep(static_cast<size_t>(id.index), id.index);
+    return;
+  }
+  std::int32_t first = -1;
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    if (!bodies_[i].alive || ctx_.body_island[i] != isl) continue;
+    if (first < 0) first = static_cast<std::int32_t>(i);
+    sleep(i, first);
+  }
+}
+
+}  // namespace cairn::detail

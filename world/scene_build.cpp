@@ -1,7 +1,7 @@
 #include "cairn/error.hpp"
 #include "cairn/scene.hpp"
 #include "world/scene_json.hpp"
-#include "world/world.hpp"
+#include "cairn/world.hpp"
 
 #include <cmath>
 
@@ -12,8 +12,7 @@ World buildWorld(const SceneDesc& scene) {
   if (!std::isfinite(scene.dt) || scene.dt <= 0)
     throw InputError("scene", "dt", "must be positive and finite (got " + std::to_string(scene.dt) + ")");
   if (scene.steps < 0) throw InputError("scene", "steps", "must be >= 0");
-  World world(scene.gravity);
-  world.setSettings(scene.solver);
+  World world(WorldDef{scene.gravity, scene.solver});
   for (const auto& b : scene.bodies) world.createBody(b);
   for (const auto& s : scene.springs) world.createSpring(s);
   for (const auto& j : scene.joints) world.createJoint(j);

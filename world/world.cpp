@@ -1,300 +1,341 @@
-#include "world/world.hpp"
+// The public World (include/cairn/world.hpp): every call checks its
+// handles, then forwards to the WorldImpl.
+#include "cairn/world.hpp"
 
 #include "cairn/error.hpp"
 #include "dynamics/forces.hpp"
-#include "dynamics/mass_properties.hpp"
-
-#include <Eigen/Eigenvalues>
+#include "world/world_impl.hpp"
 
 #include <cmath>
-#include <sstream>
 
 namespace cairn {
 
-const char* bodyTypeName(BodyType t) {
-  switch (t) {
-    case BodyType::Static: return "static";
-    case BodyType::Kinematic: return "kinematic";
-    case BodyType::Dynamic: return "dynamic";
-  }
-  return "unknown";
+using detail::WorldImpl;
+
+World::World(const WorldDef& def) : impl_(std::make_unique<WorldImpl>()) {
+  impl_->setGravity(def.gravity);
+  impl_->setSettings(def.settings);
+}
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+// --- Bodies -----------------------------------------------------------------
+
+BodyId World::createBody(const BodyDef& def) { return impl_->createBody(def); }
+void World::destroyBody(BodyId id) { impl_->destroyBody(id); }
+bool World::isValid(BodyId id) const { return impl_->valid(id); }
+int World::bodyCount() const { return impl_->aliveBodies(); }
+
+std::vector<BodyId> World::bodies() const {
+  std::vector<BodyId> out;
+  out.reserve(static_cast<size_t>(impl_->aliveBodies()));
+  for (int i = 0; i < impl_->bodySlots(); ++i)
+    if (impl_->body(i).alive) out.push_back(impl_->bodyId(i));
+  return out;
 }
 
-const char* solverMethodName(SolverMethod m) {
-  switch (m) {
-    case SolverMethod::PGS: return "pgs";
-    case SolverMethod::Direct: return "direct";
-    case SolverMethod::LCP: return "lcp";
-  }
-  return "unknown";
+BodyId World::findBody(const std::string& name) const { return impl_->findBody(name); }
+
+const std::string& World::name(BodyId id) const {
+  impl_->check(id);
+  return impl_->body(id).name;
 }
+
+BodyType World::type(BodyId id) const {
+  impl_->check(id);
+  return impl_->body(id).type;
+}
+
+void World::setType(BodyId id, BodyType type) { impl_->setType(id, type); }
+
+Transform World::transform(BodyId id) const {
+  impl_->check(id);
+  return impl_->body(id).originTransform();
+}
+
+Vec3 World::centerOfMass(BodyId id) const {
+  impl_->check(id);
+  return impl_->body(id).position;
+}
+
+void World::setTransform(BodyId id, const Vec3& position, const Quat& orientation) {
+  impl_->check(id);
+  Body& b = impl_->body(id);
+  const std::string obj = "body '" + b.name + "'";
+  if (!position.allFinite()) throw InputError(obj, "position", "must be finite");
+  if (!orientation.coeffs().allFinite() || orientation.norm() < Real(1e-9))
+    throw InputError(obj, "orientation", "must be a finite, non-zero quaternion");
+  b.orientation = orientation.normalized();
+  b.position = position + b.orientation * b.com_local;
+  b.updateDerived();
+  impl_->wakeBody(id);
+  for (const Contact& c : impl_->contacts()) {  // what it touched may fall
+    const BodyId other = c.body_a.index == id.index ? c.body_b : (c.body_b.index == id.index ? c.body_a : kWorldBody);
+    if (!other.isWorld()) impl_->wakeBody(other);
+  }
+}
+
+Vec3 World::linearVelocity(BodyId id) const {
+  impl_->check(id);
+  return impl_->body(id).linear_velocity;
+}
+
+Vec3 World::angularVelocity(BodyId id) const {
+  impl_->check(id);
+  return impl_->body(id).angular_velocity;
+}
+
+void World::setLinearVelocity(BodyId id, const Vec3& v) {
+  impl_->check(id);
+  Body& b = impl_->body(id);
+  if (!v.allFinite()) throw InputError("body '" + b.name + "'", "linear_velocity", "must be finite");
+  if (b.type == BodyType::Static) throw InputError("body '" + b.name + "'", "linear_velocity", "a static body does not move");
+  b.linear_velocity = b.isDynamic() ? b.allowedLinear(v) : v;
+  impl_->wakeBody(id);
+}
+
+void World::setAngularVelocity(BodyId id, const Vec3& w) {
+  impl_->check(id);
+  Body& b = impl_->body(id);
+  if (!w.allFinite()) throw InputError("body '" + b.name + "'", "angular_velocity", "must be finite");
+  if (b.type == BodyType::Static) throw InputError("body '" + b.name + "'", "angular_velocity", "a static body does not move");
+  b.angular_velocity = b.isDynamic() ? b.allowedAngular(w) : w;
+  impl_->wakeBody(id);
+}
+
+Vec3 World::velocityAt(BodyId id, const Vec3& world_point) const {
+  impl_->check(id);
+  return impl_->body(id).velocityAt(world_point);
+}
+
+Real World::mass(BodyId id) const {
+  impl_->check(id);
+  return impl_->body(id).mass;
+}
+
+Mat3 World::inertia(BodyId id) const {
+  impl_->check(id);
+  const Body& b = impl_->body(id);
+  if (!b.isDynamic()) return Mat3::Constant(kInf);
+  return b.rotation * b.inertia_body * b.rotation.transpose();
+}
+
+// --- Shapes ---------------------------------------------------------------------
+
+ShapeId World::addShape(BodyId body, const ShapeDesc& shape) { return impl_->addShape(body, shape); }
+void World::removeShape(ShapeId shape) { impl_->removeShape(shape); }
+
+std::vector<ShapeId> World::shapes(BodyId body) const {
+  impl_->check(body);
+  std::vector<ShapeId> out;
+  for (const std::int32_t slot : impl_->body(body).shape_ids)
+    out.push_back(ShapeId{slot, impl_->shapes()[static_cast<size_t>(slot)].generation});
+  return out;
+}
+
+BodyId World::shapeBody(ShapeId shape) const {
+  impl_->check(shape);
+  return impl_->shapes()[static_cast<size_t>(shape.index)].body;
+}
+
+const ShapeDesc& World::shape(ShapeId shape) const {
+  impl_->check(shape);
+  const ShapeRef& ref = impl_->shapes()[static_cast<size_t>(shape.index)];
+  return impl_->body(ref.body).shapes[static_cast<size_t>(ref.index)];
+}
+
+// --- Forces -------------------------------------------------------------------------
 
 namespace {
-
-std::string num(Real v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
+void requireFiniteVec(const Body& b, const char* field, const Vec3& v) {
+  if (!v.allFinite()) throw InputError("body '" + b.name + "'", field, "must be finite");
 }
-
-bool finite(Real v) { return std::isfinite(v); }
-
-void requirePositive(const std::string& obj, const std::string& field, Real v) {
-  if (!finite(v) || v <= 0) throw InputError(obj, field, "must be positive and finite (got " + num(v) + ")");
-}
-
-void requireNonNegative(const std::string& obj, const std::string& field, Real v) {
-  if (!finite(v) || v < 0) throw InputError(obj, field, "must be finite and >= 0 (got " + num(v) + ")");
-}
-
-void requireFinite(const std::string& obj, const std::string& field, const Vec3& v) {
-  if (!v.allFinite()) throw InputError(obj, field, "must be finite");
-}
-
-void validateShape(const std::string& obj, const std::string& f, const ShapeDesc& s, BodyType type) {
-  requireFinite(obj, f + ".position", s.local.p);
-  if (!s.local.q.coeffs().allFinite() || s.local.q.norm() < Real(1e-9))
-    throw InputError(obj, f + ".orientation", "must be a finite, non-zero quaternion");
-  switch (s.type) {
-    case ShapeType::Sphere: requirePositive(obj, f + ".radius", s.radius); break;
-    case ShapeType::Box:
-      for (int k = 0; k < 3; ++k) requirePositive(obj, f + ".half_extents", s.half_extents[k]);
-      break;
-    case ShapeType::Capsule:
-      requirePositive(obj, f + ".radius", s.radius);
-      requireNonNegative(obj, f + ".half_height", s.half_height);
-      break;
-    case ShapeType::Cylinder:
-      requirePositive(obj, f + ".radius", s.radius);
-      requirePositive(obj, f + ".half_height", s.half_height);
-      break;
-    case ShapeType::Plane:
-      if (type != BodyType::Static) throw InputError(obj, f + ".type", "a plane may only belong to a static body");
-      requireFinite(obj, f + ".normal", s.normal);
-      if (s.normal.norm() < Real(1e-9)) throw InputError(obj, f + ".normal", "must not be zero");
-      if (!finite(s.offset)) throw InputError(obj, f + ".offset", "must be finite");
-      break;
-    case ShapeType::ConvexHull:
-      if (!s.hull || s.hull->vertices.size() < 4 || s.hull->faces.size() < 4)
-        throw InputError(obj, f + ".points", "convex hull needs at least 4 points that are not coplanar");
-      break;
-    case ShapeType::Mesh:
-      if (type != BodyType::Static) throw InputError(obj, f + ".type", "a triangle mesh may only belong to a static body");
-      if (!s.mesh || s.mesh->triangles.empty()) throw InputError(obj, f, "triangle mesh has no triangles");
-      break;
-  }
-}
-
-bool isSymmetricPositiveDefinite(const Mat3& m) {
-  if (!m.allFinite() || !m.isApprox(m.transpose(), Real(1e-9))) return false;
-  Eigen::SelfAdjointEigenSolver<Mat3> es(m);
-  return es.eigenvalues().minCoeff() > 0;
-}
-
 }  // namespace
 
-void validateSettings(const SolverSettings& s) {
-  const std::string o = "solver";
-  if (s.iterations < 1) throw InputError(o, "iterations", "must be >= 1 (got " + std::to_string(s.iterations) + ")");
-  if (s.substeps < 1) throw InputError(o, "substeps", "must be >= 1 (got " + std::to_string(s.substeps) + ")");
-  if (!finite(s.erp) || s.erp < 0 || s.erp > 1) throw InputError(o, "erp", "must lie in [0, 1] (got " + num(s.erp) + ")");
-  if (!finite(s.contact_erp) || s.contact_erp < 0 || s.contact_erp > 1)
-    throw InputError(o, "contact_erp", "must lie in [0, 1] (got " + num(s.contact_erp) + ")");
-  requireNonNegative(o, "cfm", s.cfm);
-  requireNonNegative(o, "tolerance", s.tolerance);
-  if (!finite(s.sor) || s.sor <= 0 || s.sor >= 2) throw InputError(o, "sor", "must lie in (0, 2) (got " + num(s.sor) + ")");
-  if (!finite(s.warm_start_factor) || s.warm_start_factor < 0 || s.warm_start_factor > 1)
-    throw InputError(o, "warm_start_factor", "must lie in [0, 1] (got " + num(s.warm_start_factor) + ")");
-  requireNonNegative(o, "slop", s.slop);
-  requireNonNegative(o, "restitution_threshold", s.restitution_threshold);
-  if (!(s.max_correction_velocity > 0)) throw InputError(o, "max_correction_velocity", "must be positive");
-  if (!(s.max_angular_velocity > 0)) throw InputError(o, "max_angular_velocity", "must be positive");
-  requireNonNegative(o, "contact_margin", s.contact_margin);
-  requireNonNegative(o, "sleep_linear_velocity", s.sleep_linear_velocity);
-  requireNonNegative(o, "sleep_angular_velocity", s.sleep_angular_velocity);
-  requireNonNegative(o, "sleep_time", s.sleep_time);
-}
-
-BodyId World::createBody(const BodyDef& def) {
-  // 1. Validate everything; nothing is touched until this passes.
-  if (def.name.empty()) throw InputError("body #" + std::to_string(bodies_.size()), "name", "missing body name");
-  const std::string obj = "body '" + def.name + "'";
-  if (findBody(def.name).index >= 0) throw InputError(obj, "name", "another body has this name");
-  requireFinite(obj, "position", def.position);
-  if (!def.orientation.coeffs().allFinite()) throw InputError(obj, "orientation", "must be finite");
-  if (def.orientation.norm() < Real(1e-9)) throw InputError(obj, "orientation", "zero-length quaternion");
-  requireFinite(obj, "linear_velocity", def.linear_velocity);
-  requireFinite(obj, "angular_velocity", def.angular_velocity);
-  requireNonNegative(obj, "friction", def.friction);
-  if (!finite(def.restitution) || def.restitution < 0 || def.restitution > 1)
-    throw InputError(obj, "restitution", "must lie in [0, 1] (got " + num(def.restitution) + ")");
-  requireNonNegative(obj, "rolling_friction", def.rolling_friction);
-  requireNonNegative(obj, "torsional_friction", def.torsional_friction);
-  requireNonNegative(obj, "linear_damping", def.linear_damping);
-  requireNonNegative(obj, "angular_damping", def.angular_damping);
-  for (size_t i = 0; i < def.shapes.size(); ++i)
-    validateShape(obj, "shapes[" + std::to_string(i) + "]", def.shapes[i], def.type);
-
-  Body b;
-  b.name = def.name;
-  b.type = def.type;
-  b.orientation = def.orientation.normalized();
-  b.friction = def.friction;
-  b.restitution = def.restitution;
-  b.linear_damping = def.linear_damping;
-  b.angular_damping = def.angular_damping;
-  b.ccd = def.ccd;
-  b.rolling_friction = def.rolling_friction;
-  b.torsional_friction = def.torsional_friction;
-  b.collision_group = def.collision_group;
-  b.collision_mask = def.collision_mask;
-  b.shapes = def.shapes;
-  for (auto& s : b.shapes) s.local.q.normalize();
-
-  Vec3 com_local = Vec3::Zero();
-  if (def.type == BodyType::Dynamic) {
-    if (def.mass && def.density) throw InputError(obj, "mass", "give mass or density, not both");
-    if (def.mass) requirePositive(obj, "mass", *def.mass);
-    if (def.density) requirePositive(obj, "density", *def.density);
-    if (def.inertia && !isSymmetricPositiveDefinite(*def.inertia))
-      throw InputError(obj, "inertia", "must be a finite, symmetric, positive definite 3x3 matrix");
-    Real volume = 0;
-    for (const auto& s : def.shapes) volume += shapeVolume(s);
-    MassProperties mp;
-    if (volume > 0) {
-      // Density from the mass if the mass is given; 1000 kg/m^3 (water) by default.
-      const Real density = def.mass ? *def.mass / volume : def.density.value_or(Real(1000));
-      mp = compoundMassProperties(def.shapes, density);
-      if (def.mass) mp.mass = *def.mass;  // exact, not volume * density round-off
-    } else {
-      if (!def.mass) throw InputError(obj, "mass", "a dynamic body without solid shapes needs a mass");
-      if (!def.inertia) throw InputError(obj, "inertia", "a dynamic body without solid shapes needs an inertia");
-      mp.mass = *def.mass;
-    }
-    if (def.inertia) mp.inertia = *def.inertia;
-    if (!isSymmetricPositiveDefinite(mp.inertia))
-      throw InputError(obj, "shapes", "the shapes give a degenerate inertia tensor");
-    com_local = mp.center;
-    b.mass = mp.mass;
-    b.inv_mass = 1 / mp.mass;
-    b.inertia_body = mp.inertia;
-    b.inv_inertia_body = mp.inertia.inverse();
-    b.linear_velocity = def.linear_velocity;
-    b.angular_velocity = def.angular_velocity;
-  } else {
-    b.mass = kInf;
-    if (def.type == BodyType::Kinematic) {
-      b.linear_velocity = def.linear_velocity;
-      b.angular_velocity = def.angular_velocity;
-      Real volume = 0;
-      for (const auto& s : def.shapes) volume += shapeVolume(s);
-      if (volume > 0) com_local = compoundMassProperties(def.shapes, 1).center;
-    }
-  }
-  // The body origin moves to the center of mass; shapes keep their place.
-  b.position = def.position + b.orientation * com_local;
-  for (auto& s : b.shapes) s.local.p -= com_local;
-  b.updateDerived();
-
-  // 2. Commit.
-  step_start_.push_back({b.position, b.orientation, b.linear_velocity, b.angular_velocity});  // its last good state
-  bodies_.push_back(std::move(b));
-  orientation_offset_.push_back(Vec3::Zero());
-  sleep_island_.push_back(-1);
-  body_island_.push_back(-1);
-  const BodyId id{static_cast<std::int32_t>(bodies_.size() - 1)};
-  registerShapes(id);
-  return id;
-}
-
-int World::createSpring(const SpringDef& def) {
-  const std::string obj = "spring '" + (def.name.empty() ? "#" + std::to_string(springs_.size()) : def.name) + "'";
-  const auto checkBody = [&](BodyId id, const char* field) {
-    if (!id.isWorld() && id.index >= bodyCount()) throw InputError(obj, field, "no such body");
-  };
-  checkBody(def.body_a, "bodies[0]");
-  checkBody(def.body_b, "bodies[1]");
-  if (def.body_a == def.body_b && !def.body_a.isWorld()) throw InputError(obj, "bodies", "a spring needs two different bodies");
-  requireFinite(obj, "anchors[0]", def.anchor_a);
-  requireFinite(obj, "anchors[1]", def.anchor_b);
-  requireNonNegative(obj, "stiffness", def.stiffness);
-  requireNonNegative(obj, "damping", def.damping);
-  if (def.rest_length) requireNonNegative(obj, "rest_length", *def.rest_length);
-
-  Spring s;
-  s.def = def;
-  s.local_a = def.body_a.isWorld() ? def.anchor_a : body(def.body_a).transform().applyInverse(def.anchor_a);
-  s.local_b = def.body_b.isWorld() ? def.anchor_b : body(def.body_b).transform().applyInverse(def.anchor_b);
-  s.rest_length = def.rest_length.value_or((def.anchor_b - def.anchor_a).norm());
-  springs_.push_back(s);
-  return static_cast<int>(springs_.size() - 1);
-}
-
-BodyId World::findBody(const std::string& name) const {
-  for (size_t i = 0; i < bodies_.size(); ++i)
-    if (bodies_[i].name == name) return BodyId{static_cast<std::int32_t>(i)};
-  return kWorldBody;
-}
-
-// Pushing a body wakes it (and its island).
 void World::applyForce(BodyId id, const Vec3& force, const Vec3& world_point) {
-  wakeBody(id);
-  applyForceAtPoint(body(id), force, world_point);
+  impl_->check(id);
+  requireFiniteVec(impl_->body(id), "force", force);
+  requireFiniteVec(impl_->body(id), "point", world_point);
+  impl_->applyForce(id, force, world_point);
 }
+
 void World::applyCentralForce(BodyId id, const Vec3& force) {
-  wakeBody(id);
-  body(id).force += force;
+  impl_->check(id);
+  requireFiniteVec(impl_->body(id), "force", force);
+  impl_->applyCentralForce(id, force);
 }
+
 void World::applyTorque(BodyId id, const Vec3& torque) {
-  wakeBody(id);
-  body(id).torque += torque;
+  impl_->check(id);
+  requireFiniteVec(impl_->body(id), "torque", torque);
+  impl_->applyTorque(id, torque);
 }
+
 void World::applyImpulse(BodyId id, const Vec3& impulse, const Vec3& world_point) {
-  wakeBody(id);
-  applyImpulseAtPoint(body(id), impulse, world_point);
+  impl_->check(id);
+  requireFiniteVec(impl_->body(id), "impulse", impulse);
+  requireFiniteVec(impl_->body(id), "point", world_point);
+  impl_->applyImpulse(id, impulse, world_point);
+}
+
+void World::applyAngularImpulse(BodyId id, const Vec3& angular_impulse) {
+  impl_->check(id);
+  Body& b = impl_->body(id);
+  requireFiniteVec(b, "angular_impulse", angular_impulse);
+  impl_->wakeBody(id);
+  if (b.isDynamic()) b.angular_velocity += b.inv_inertia_world * angular_impulse;
 }
 
 void World::setKinematicVelocity(BodyId id, const Vec3& linear, const Vec3& angular) {
-  Body& b = body(id);
-  if (b.type != BodyType::Kinematic) throw InputError("body '" + b.name + "'", "type", "not a kinematic body");
-  if (!linear.allFinite() || !angular.allFinite()) throw InputError("body '" + b.name + "'", "velocity", "must be finite");
-  b.linear_velocity = linear;
-  b.angular_velocity = angular;
+  impl_->check(id);
+  impl_->setKinematicVelocity(id, linear, angular);
 }
 
-void World::setGravity(const Vec3& g) {
-  requireFinite("world", "gravity", g);
-  gravity_ = g;
+// --- Joints and springs -------------------------------------------------------------
+
+JointId World::createJoint(const JointDef& def) { return impl_->createJoint(def); }
+void World::destroyJoint(JointId id) { impl_->destroyJoint(id); }
+bool World::isValid(JointId id) const { return impl_->valid(id); }
+JointId World::findJoint(const std::string& name) const { return impl_->findJoint(name); }
+
+const JointDef& World::jointDef(JointId id) const {
+  impl_->check(id);
+  return impl_->joint(id).def;
 }
 
-void World::setSettings(const SolverSettings& s) {
-  validateSettings(s);
-  settings_ = s;
+JointFeedback World::jointFeedback(JointId id) const {
+  impl_->check(id);
+  return impl_->jointFeedback(id);
 }
 
-Real World::kineticEnergy() const {
-  Real e = 0;
-  for (const auto& b : bodies_) e += b.kineticEnergy();
-  return e;
+JointError World::jointError(JointId id) const {
+  impl_->check(id);
+  return impl_->jointError(id);
 }
 
-Real World::potentialEnergy() const {
-  Real e = 0;
-  for (const auto& b : bodies_)
-    if (b.isDynamic()) e -= b.mass * gravity_.dot(b.position);
-  for (const auto& s : springs_) {
-    const Vec3 pa = s.def.body_a.isWorld() ? s.local_a : body(s.def.body_a).transform().apply(s.local_a);
-    const Vec3 pb = s.def.body_b.isWorld() ? s.local_b : body(s.def.body_b).transform().apply(s.local_b);
-    e += springEnergy((pb - pa).norm(), s.rest_length, s.def.stiffness);
+bool World::isBroken(JointId id) const {
+  impl_->check(id);
+  return impl_->joint(id).broken;
+}
+
+void World::setMotor(JointId id, const MotorDef& motor) {
+  impl_->check(id);
+  Joint& j = impl_->joint(id);
+  JointDef d = j.def;
+  d.motor = motor;
+  validateJointDef(d, impl_->bodySlots());
+  j.def.motor = motor;
+  if (!d.body_a.isWorld()) impl_->wakeBody(d.body_a);
+  if (!d.body_b.isWorld()) impl_->wakeBody(d.body_b);
+}
+
+SpringId World::createSpring(const SpringDef& def) { return impl_->createSpring(def); }
+void World::destroySpring(SpringId id) { impl_->destroySpring(id); }
+bool World::isValid(SpringId id) const { return impl_->valid(id); }
+
+// --- Contacts -------------------------------------------------------------------------
+
+namespace {
+ContactData contactData(const WorldImpl& w, const Contact& c) {
+  ContactData d;
+  d.body_a = c.body_a;
+  d.body_b = c.body_b;
+  d.shape_a = ShapeId{c.shape_a, w.shapes()[static_cast<size_t>(c.shape_a)].generation};
+  d.shape_b = ShapeId{c.shape_b, w.shapes()[static_cast<size_t>(c.shape_b)].generation};
+  d.normal = c.normal;
+  d.count = c.count;
+  d.touching = c.touching;
+  const Transform ta = w.body(c.body_a).transform(), tb = w.body(c.body_b).transform();
+  for (int i = 0; i < c.count; ++i) {
+    const Vec3 pa = ta.apply(c.points[i].local_a), pb = tb.apply(c.points[i].local_b);
+    d.points[i] = Real(0.5) * (pa + pb);
+    d.depths[i] = c.points[i].depth;
+    d.normal_impulses[i] = c.points[i].normal_impulse;
+    d.friction_impulses[i] = c.points[i].friction_impulse;
   }
-  return e;
+  return d;
+}
+}  // namespace
+
+std::vector<ContactData> World::contacts(BodyId id) const {
+  impl_->check(id);
+  std::vector<ContactData> out;
+  for (const Contact& c : impl_->contacts())
+    if (c.enabled && (c.body_a.index == id.index || c.body_b.index == id.index)) out.push_back(contactData(*impl_, c));
+  return out;
 }
 
-Vec3 World::linearMomentum() const {
-  Vec3 p = Vec3::Zero();
-  for (const auto& b : bodies_)
-    if (b.isDynamic()) p += b.mass * b.linear_velocity;
-  return p;
+std::vector<ContactData> World::contacts() const {
+  std::vector<ContactData> out;
+  for (const Contact& c : impl_->contacts())
+    if (c.enabled) out.push_back(contactData(*impl_, c));
+  return out;
 }
+
+std::span<const ContactEvent> World::contactEvents() const { return impl_->contactEvents(); }
+void World::setPreSolveCallback(ContactCallback callback) { impl_->setContactCallback(std::move(callback)); }
+
+void World::setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution) {
+  impl_->check(a);
+  impl_->check(b);
+  impl_->setPairMaterial(a, b, friction, restitution);
+}
+
+// --- Collision filtering ----------------------------------------------------------------
+
+void World::setCollisionFilter(BodyId id, std::uint32_t group, std::uint32_t mask) {
+  impl_->check(id);
+  Body& b = impl_->body(id);
+  b.collision_group = group;
+  b.collision_mask = mask;
+  impl_->wakeBody(id);
+}
+
+void World::setCollisionFilterCallback(CollisionFilter filter) { impl_->setCollisionFilterCallback(std::move(filter)); }
+
+// --- Sleeping -------------------------------------------------------------------------------
+
+bool World::isAsleep(BodyId id) const {
+  impl_->check(id);
+  return impl_->isAsleep(id);
+}
+
+void World::wake(BodyId id) {
+  impl_->check(id);
+  impl_->wakeBody(id);
+}
+
+void World::putToSleep(BodyId id) {
+  impl_->check(id);
+  impl_->putIslandToSleep(id);
+}
+
+void World::setSleepingAllowed(BodyId id, bool allowed) {
+  impl_->check(id);
+  impl_->body(id).sleeping_allowed = allowed;
+  if (!allowed) impl_->wakeBody(id);
+}
+
+// --- Settings -------------------------------------------------------------------------------
+
+const Vec3& World::gravity() const { return impl_->gravity(); }
+void World::setGravity(const Vec3& g) { impl_->setGravity(g); }
+const SolverSettings& World::settings() const { return impl_->settings(); }
+void World::setSettings(const SolverSettings& s) { impl_->setSettings(s); }
+
+// --- Stepping -------------------------------------------------------------------------------
+
+void World::step(Real h) { impl_->step(h); }
+int World::stepCount() const { return impl_->stepCount(); }
+Real World::time() const { return impl_->time(); }
+const StepStats& World::lastStepStats() const { return impl_->lastStepStats(); }
+std::span<const JointBreakEvent> World::jointBreakEvents() const { return impl_->jointBreakEvents(); }
+std::span<const NumericalEvent> World::numericalEvents() const { return impl_->numericalEvents(); }
+std::span<const Diagnostic> World::diagnostics() const { return impl_->diagnostics(); }
+
+Real World::kineticEnergy() const { return impl_->kineticEnergy(); }
+Real World::potentialEnergy() const { return impl_->potentialEnergy(); }
+Vec3 World::linearMomentum() const { return impl_->linearMomentum(); }
 
 }  // namespace cairn

@@ -1,13 +1,15 @@
-// Stage 3 of the step: broadphase -> filtering -> narrowphase -> contact
-// cache (warm-start impulses matched by feature id) -> callback -> events.
-#include "collision/aabb.hpp"
+// Stage 2 of the step: broadphase -> filtering -> narrowphase -> contact
+// cache (warm-start impulses matched by feature id) -> callback; and, after
+// the solve, the contact events.
 #include "cairn/error.hpp"
-#include "world/world.hpp"
+#include "collision/aabb.hpp"
+#include "collision/narrowphase.hpp"
+#include "world/step_stages.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-namespace cairn {
+namespace cairn::detail {
 
 namespace {
 
@@ -25,21 +27,29 @@ Real reach(const Body& b, Real margin, Real h) {
 
 }  // namespace
 
-void World::registerShapes(BodyId id) {
-  const Body& b = body(id);
-  for (size_t i = 0; i < b.shapes.size(); ++i) {
-    ShapeRef ref;
-    ref.body = id;
-    ref.index = static_cast<std::int32_t>(i);
-    const Transform t = b.transform() * b.shapes[i].local;
-    Aabb box = shapeAabb(b.shapes[i], t);
-    if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
-    ref.proxy = broadphase_.createProxy(box, static_cast<int>(shapes_.size()));
-    shapes_.push_back(ref);
+void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
+  Body& b = body(id);
+  std::int32_t slot;
+  if (!free_shapes_.empty()) {
+    slot = free_shapes_.back();
+    free_shapes_.pop_back();
+  } else {
+    slot = static_cast<std::int32_t>(shapes_.size());
+    shapes_.emplace_back();
+    shapes_.back().alive = false;
   }
+  ShapeRef& ref = shapes_[static_cast<size_t>(slot)];
+  ref.body = id;
+  ref.index = index_in_body;
+  ref.alive = true;
+  const ShapeDesc& shape = b.shapes[static_cast<size_t>(index_in_body)];
+  Aabb box = shapeAabb(shape, b.transform() * shape.local);
+  if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
+  ref.proxy = broadphase_.createProxy(box, slot);
+  b.shape_ids[static_cast<size_t>(index_in_body)] = slot;
 }
 
-void World::setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution) {
+void WorldImpl::setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution) {
   if (!std::isfinite(friction) || friction < 0) throw InputError("pair material", "friction", "must be finite and >= 0");
   if (!std::isfinite(restitution) || restitution < 0 || restitution > 1)
     throw InputError("pair material", "restitution", "must lie in [0, 1]");
@@ -50,19 +60,22 @@ void World::setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution)
   else pair_materials_.insert(it, {key, friction, restitution});
 }
 
-bool World::shouldCollide(const Body& a, const Body& b, BodyId ia, BodyId ib) const {
-  if (ia == ib) return false;
+bool WorldImpl::shouldCollide(const Body& a, const Body& b, BodyId ia, BodyId ib) const {
+  if (ia.index == ib.index) return false;
   if (!a.isDynamic() && !b.isDynamic()) return false;  // static and kinematic never collide with each other
   if ((a.collision_group & b.collision_mask) == 0 || (b.collision_group & a.collision_mask) == 0) return false;
   // A pair that shares a joint does not collide unless the joint says so.
   for (const Joint& j : joints_) {
-    if (j.broken || j.def.collide_connected) continue;
-    if ((j.def.body_a == ia && j.def.body_b == ib) || (j.def.body_a == ib && j.def.body_b == ia)) return false;
+    if (!j.alive || j.broken || j.def.collide_connected) continue;
+    if ((j.def.body_a.index == ia.index && j.def.body_b.index == ib.index) ||
+        (j.def.body_a.index == ib.index && j.def.body_b.index == ia.index))
+      return false;
   }
+  if (filter_callback_ && !filter_callback_(ia, ib)) return false;
   return true;
 }
 
-Real World::maxPenetration() const {
+Real WorldImpl::maxPenetration() const {
   Real worst = 0;
   for (const Contact& c : contacts_) {
     if (!c.enabled) continue;
@@ -73,40 +86,57 @@ Real World::maxPenetration() const {
   return worst;
 }
 
-void World::detectContacts(Real h) {
+void collide(WorldImpl& w, StepContext& ctx) {
+  const Real h = ctx.h;
+  const SolverSettings& settings_ = w.settings_;
+  BroadPhase& broadphase_ = w.broadphase_;
+  std::vector<Contact>& contacts_ = w.contacts_;
+  std::vector<Contact>& old_contacts_ = w.old_contacts_;
+  const auto body = [&](BodyId id) -> const Body& { return w.body(id); };
   // 1. Broadphase: move the proxies of bodies that can move.
-  for (const ShapeRef& ref : shapes_) {
+  for (const ShapeRef& ref : w.shapes_) {
+    if (!ref.alive) continue;
     const Body& b = body(ref.body);
     if (b.type == BodyType::Static || b.asleep) continue;
     const Transform t = b.transform() * b.shapes[static_cast<size_t>(ref.index)].local;
     const Aabb box = shapeAabb(b.shapes[static_cast<size_t>(ref.index)], t).expanded(reach(b, settings_.contact_margin, h));
     broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
   }
-  broadphase_.updatePairs(pairs_);
+  broadphase_.updatePairs(w.pairs_);
 
   // 2. Narrowphase over the candidate pairs, matching last step's contacts.
   std::swap(old_contacts_, contacts_);
   contacts_.clear();
-  for (const auto& [pa, pb] : pairs_) {
+  const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
+  if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key))
+    std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
+  for (const auto& [pa, pb] : w.pairs_) {
     std::int32_t sa = broadphase_.user(pa), sb = broadphase_.user(pb);
     if (sa > sb) std::swap(sa, sb);
-    const ShapeRef& ra = shapes_[static_cast<size_t>(sa)];
-    const ShapeRef& rb = shapes_[static_cast<size_t>(sb)];
+    const ShapeRef& ra = w.shapes_[static_cast<size_t>(sa)];
+    const ShapeRef& rb = w.shapes_[static_cast<size_t>(sb)];
     const Body& ba = body(ra.body);
     const Body& bb = body(rb.body);
-    if (!shouldCollide(ba, bb, ra.body, rb.body)) continue;
+    if (!w.shouldCollide(ba, bb, ra.body, rb.body)) continue;
     const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
     if (a_still && b_still && (ba.asleep || bb.asleep)) {
-      // Nothing here moves: keep the cached contacts as they were.
-      for (const Contact& c : old_contacts_)
-        if (c.shape_a == sa && c.shape_b == sb) contacts_.push_back(c);
+      // Nothing here moves: keep the cached contacts as they were. They are
+      // sorted by key, whose high bits are the two shapes: a binary search.
+      Contact probe;
+      probe.shape_a = sa;
+      probe.shape_b = sb;
+      probe.triangle = -1;
+      auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), probe.key(),
+                                 [](const Contact& x, std::uint64_t k) { return x.key() < k; });
+      for (; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it) contacts_.push_back(*it);
       continue;
     }
     const ShapeDesc& sda = ba.shapes[static_cast<size_t>(ra.index)];
     const ShapeDesc& sdb = bb.shapes[static_cast<size_t>(rb.index)];
     const Real margin = std::max(reach(ba, settings_.contact_margin, h), reach(bb, settings_.contact_margin, h));
+    std::vector<Manifold>& manifolds_ = w.manifolds_;
     manifolds_.clear();
-    collide(sda, ba.transform() * sda.local, sdb, bb.transform() * sdb.local, margin, manifolds_);
+    cairn::collide(sda, ba.transform() * sda.local, sdb, bb.transform() * sdb.local, margin, manifolds_);
     for (const Manifold& m : manifolds_) {
       if (m.count == 0) continue;
       Contact c;
@@ -122,9 +152,9 @@ void World::detectContacts(Real h) {
       c.rolling_friction = std::max(ba.rolling_friction, bb.rolling_friction);
       c.torsional_friction = std::max(ba.torsional_friction, bb.torsional_friction);
       const std::uint64_t pk = bodyPairKey(ra.body, rb.body);
-      const auto mat = std::lower_bound(pair_materials_.begin(), pair_materials_.end(), pk,
-                                        [](const PairMaterial& x, std::uint64_t k) { return x.key < k; });
-      if (mat != pair_materials_.end() && mat->key == pk) {
+      const auto mat = std::lower_bound(w.pair_materials_.begin(), w.pair_materials_.end(), pk,
+                                        [](const WorldImpl::PairMaterial& x, std::uint64_t k) { return x.key < k; });
+      if (mat != w.pair_materials_.end() && mat->key == pk) {
         c.friction = mat->friction;
         c.restitution = mat->restitution;
       }
@@ -147,12 +177,10 @@ void World::detectContacts(Real h) {
   // Contacts in key order (deterministic, and for the lookup below). The
   // broadphase hands pairs over in a stable order, so this is usually
   // sorted already: checking first spares moving every contact.
-  const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
   if (!std::is_sorted(contacts_.begin(), contacts_.end(), by_key)) std::stable_sort(contacts_.begin(), contacts_.end(), by_key);
 
   // 3. Warm start: carry impulses from last step's points with the same
   //    feature id (or, failing that, within 2 cm on body A).
-  if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key)) std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
   for (Contact& c : contacts_) {
     const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
                                      [](const Contact& x, std::uint64_t k) { return x.key() < k; });
@@ -177,7 +205,7 @@ void World::detectContacts(Real h) {
   }
 
   // 4. The user's callback may veto or modify each contact.
-  if (contact_callback_) {
+  if (w.contact_callback_) {
     for (Contact& c : contacts_) {
       ContactInfo info;
       info.body_a = c.body_a;
@@ -196,7 +224,7 @@ void World::detectContacts(Real h) {
       info.relative_velocity = body(c.body_b).velocityAt(info.points[deepest]) - body(c.body_a).velocityAt(info.points[deepest]);
       info.friction = c.friction;
       info.restitution = c.restitution;
-      contact_callback_(info);
+      w.contact_callback_(info);
       c.enabled = info.enabled;
       c.friction = std::max(Real(0), info.friction);
       c.restitution = std::clamp(info.restitution, Real(0), Real(1));
@@ -205,12 +233,17 @@ void World::detectContacts(Real h) {
 }
 
 // Begin events are emitted after the solve so they carry the impulse of
-// their first step; End events name contacts that no longer touch.
-void World::emitContactEvents(const std::vector<Contact>& old) {
-  const auto event = [this](const Contact& c, ContactEvent::Type type) {
+// their first step; End events name contacts that no longer touch (and
+// those removed with a body or shape since the last step).
+void emitContactEvents(WorldImpl& w, StepContext&) {
+  const std::vector<Contact>& contacts_ = w.contacts_;
+  const std::vector<Contact>& old = w.old_contacts_;
+  std::vector<ContactEvent>& contact_events_ = w.contact_events_;
+  const auto body = [&](BodyId id) -> const Body& { return w.body(id); };
+  const auto event = [&](const Contact& c, ContactEvent::Type type) {
     ContactEvent e;
     e.type = type;
-    e.step = step_count_;
+    e.step = w.step_count_;
     e.body_a = c.body_a;
     e.body_b = c.body_b;
     e.shape_a = c.shape_a;
@@ -235,6 +268,9 @@ void World::emitContactEvents(const std::vector<Contact>& old) {
     if (it != contacts_.end() && it->key() == o.key()) continue;
     contact_events_.push_back(event(o, ContactEvent::Type::End));
   }
+  for (const Contact& o : w.ended_contacts_)
+    if (o.touching && o.enabled) contact_events_.push_back(event(o, ContactEvent::Type::End));
+  w.ended_contacts_.clear();
 }
 
-}  // namespace cairn
+}  // namespace cairn::detail

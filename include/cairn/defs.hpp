@@ -3,6 +3,7 @@
 // definition completely before it changes anything.
 #pragma once
 
+#include "cairn/handles.hpp"
 #include "cairn/shape.hpp"
 
 #include <cstdint>
@@ -15,19 +16,6 @@ namespace cairn {
 enum class BodyType { Static, Kinematic, Dynamic };
 
 const char* bodyTypeName(BodyType t);
-
-// Small integer handles into the World's arrays (never pointers).
-struct BodyId {
-  std::int32_t index = -1;
-  bool isWorld() const { return index < 0; }
-  friend bool operator==(BodyId a, BodyId b) { return a.index == b.index; }
-};
-inline constexpr BodyId kWorldBody{-1};
-
-struct JointId {
-  std::int32_t index = -1;
-  friend bool operator==(JointId a, JointId b) { return a.index == b.index; }
-};
 
 struct BodyDef {
   std::string name;
@@ -53,6 +41,31 @@ struct BodyDef {
   // (a.group & b.mask) != 0 and (b.group & a.mask) != 0.
   std::uint32_t collision_group = 1;
   std::uint32_t collision_mask = 0xffffffffu;
+  bool sleeping_allowed = true;  // false: the body's island never sleeps
+
+  // External loads (world frame), for scripted pushes in scene files:
+  // a force and a torque applied at the center of mass in every step, and
+  // impulses applied once each, at the start of the first step that begins
+  // at or after their time.
+  Vec3 force = Vec3::Zero();   // N
+  Vec3 torque = Vec3::Zero();  // N m
+  struct TimedImpulse {
+    Real time = 0;                   // s
+    Vec3 impulse = Vec3::Zero();     // N s
+    std::optional<Vec3> point;       // world point at that time; default: the center of mass
+  };
+  std::vector<TimedImpulse> impulses;
+
+  // Degrees of freedom locked by the mass matrix (Jolt's AllowedDOFs,
+  // Bullet's linear and angular factors): world axes the body may neither
+  // translate along nor rotate about. The effective inverse mass and
+  // inertia are projected so that no impulse or force moves the body along
+  // them, exactly (no constraint rows that could stretch). Translation
+  // locks take the world axes x, y and z (unit vectors, either sign); a
+  // translation along any other line is a slider joint's job. Rotation
+  // locks take any non-zero world vectors.
+  std::vector<Vec3> lock_translation;
+  std::vector<Vec3> lock_rotation;
 };
 
 struct SpringDef {

@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace cairn {
 
@@ -30,6 +31,13 @@ class InputError : public std::runtime_error {
 
  private:
   std::string object_, field_, message_;
+};
+
+// A handle that names nothing in this world: its object was destroyed (a
+// stale handle: the slot's generation moved on) or it never existed here.
+class HandleError : public InputError {
+ public:
+  HandleError(std::string object, const std::string& message) : InputError(std::move(object), "", message) {}
 };
 
 // A step that produced a non-finite state: names the body and the stage.

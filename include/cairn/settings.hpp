@@ -37,6 +37,13 @@ enum class OrientationIntegrator {
   Derivative       // q <- normalize(q + h/2 w q), section 12.6.4's first method
 };
 
+// Which vector instructions the contact solver uses. Auto: the widest this
+// CPU supports among those built in. All give bit-identical results
+// (docs/performance.md); Portable runs on any CPU.
+enum class Simd { Auto, Portable, Avx2, Avx512 };
+
+const char* simdName(Simd s);
+
 enum class SolverMethod { PGS, Direct, LCP };
 
 const char* solverMethodName(SolverMethod m);
@@ -53,6 +60,8 @@ struct SolverSettings {
   std::uint64_t seed = 1;
   int substeps = 1;             // sub-steps per step
   int threads = 1;              // worker threads for the step (results are bit-identical for any count)
+  Simd simd = Simd::Auto;       // contact solver instruction set
+  bool compute_residual = false;  // fill StepStats::residual (one extra pass over the rows)
 
   // ODE-style softness: rows drive J v toward -ERP/h C, CFM softens them.
   Real erp = Real(0.2);

@@ -3,7 +3,7 @@
 // origin. The long ones are in tests/long/extremes_test.cpp, with the
 // criteria for "holds".
 #include "validation/extremes.hpp"
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <gtest/gtest.h>
 

@@ -21,8 +21,8 @@ TEST(Projectile, MatchesExactDiscreteSemiImplicitEuler) {
     w.step(h);
     const Vec3 v = d.linear_velocity + n * h * g;
     const Vec3 x = d.position + n * h * d.linear_velocity + h * h * g * (n * (n + 1) / 2.0);
-    ASSERT_LT((w.body(id).linear_velocity - v).norm(), 1e-10) << "step " << n;
-    ASSERT_LT((w.body(id).position - x).norm(), 1e-9) << "step " << n;
+    ASSERT_LT((cairn::detail::internals(w).body(id).linear_velocity - v).norm(), 1e-10) << "step " << n;
+    ASSERT_LT((cairn::detail::internals(w).body(id).position - x).norm(), 1e-9) << "step " << n;
   }
 }
 

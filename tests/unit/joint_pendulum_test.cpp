@@ -29,10 +29,10 @@ World makePendulum(Real amplitude) {
 // Mean period from upward zero crossings of the angle, linearly interpolated.
 Real measurePeriod(World& w, Real h, int steps) {
   std::vector<Real> crossings;
-  Real prev = std::atan2(w.bodies()[0].position.x(), -w.bodies()[0].position.y());
+  Real prev = std::atan2(cairn::detail::internals(w).bodies()[0].position.x(), -cairn::detail::internals(w).bodies()[0].position.y());
   for (int s = 1; s <= steps; ++s) {
     w.step(h);
-    const Real th = std::atan2(w.bodies()[0].position.x(), -w.bodies()[0].position.y());
+    const Real th = std::atan2(cairn::detail::internals(w).bodies()[0].position.x(), -cairn::detail::internals(w).bodies()[0].position.y());
     if (prev < 0 && th >= 0) crossings.push_back(w.time() - h * th / (th - prev));
     prev = th;
   }

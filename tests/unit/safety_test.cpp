@@ -53,20 +53,20 @@ bool sameState(const Body& a, const Body& b) {
 }
 
 void expectAllFinite(const World& w) {
-  for (const Body& b : w.bodies()) {
+  for (const Body& b : cairn::detail::internals(w).bodies()) {
     EXPECT_TRUE(b.position.allFinite() && b.orientation.coeffs().allFinite() && b.linear_velocity.allFinite() &&
                 b.angular_velocity.allFinite())
         << b.name;
     EXPECT_TRUE(b.force.allFinite() && b.torque.allFinite()) << b.name;
   }
-  for (const Contact& c : w.contacts()) {
+  for (const Contact& c : cairn::detail::internals(w).contacts()) {
     for (int i = 0; i < c.count; ++i) {
       EXPECT_TRUE(std::isfinite(c.points[i].normal_impulse));
       EXPECT_TRUE(c.points[i].friction_impulse.allFinite());
     }
   }
-  for (int j = 0; j < w.jointCount(); ++j) {
-    for (Real l : w.joint(JointId{j}).warm) EXPECT_TRUE(std::isfinite(l));
+  for (int j = 0; j < cairn::detail::internals(w).jointSlots(); ++j) {
+    for (Real l : cairn::detail::internals(w).joint(JointId{j}).warm) EXPECT_TRUE(std::isfinite(l));
   }
 }
 
@@ -83,12 +83,14 @@ TEST(NanGuard, NanForceStopsOnlyItsIsland) {
   std::vector<Body> before;
   for (int s = 0; s < 90; ++s) {
     if (s == 30) {
-      w.applyCentralForce(bad, Vec3(kNaN, 0, 0));
-      before = w.bodies();
+      // The public API refuses a NaN force (below); the guard is the net
+      // for one that gets in anyway.
+      cairn::detail::internals(w).applyCentralForce(bad, Vec3(kNaN, 0, 0));
+      before = cairn::detail::internals(w).bodies();
     }
     w.step(kH);
     ref.step(kH);
-    for (int k = 1; k <= 3; ++k) ASSERT_TRUE(sameState(w.body(BodyId{k}), ref.body(BodyId{k}))) << "step " << s;
+    for (int k = 1; k <= 3; ++k) ASSERT_TRUE(sameState(cairn::detail::internals(w).body(BodyId{k}), cairn::detail::internals(ref).body(BodyId{k}))) << "step " << s;
     if (s == 30) {
       ASSERT_EQ(w.numericalEvents().size(), 1u);
       const NumericalEvent& e = w.numericalEvents()[0];
@@ -100,7 +102,7 @@ TEST(NanGuard, NanForceStopsOnlyItsIsland) {
       EXPECT_GE(e.island, 0);
       EXPECT_EQ(e.bodies_restored, 3);
       for (int k = 4; k <= 6; ++k) {  // the bad column: its step-start pose, at rest
-        const Body& b = w.body(BodyId{k});
+        const Body& b = cairn::detail::internals(w).body(BodyId{k});
         EXPECT_EQ(b.position, before[static_cast<size_t>(k)].position) << b.name;
         EXPECT_EQ(b.orientation.coeffs(), before[static_cast<size_t>(k)].orientation.coeffs()) << b.name;
         EXPECT_EQ(b.linear_velocity, Vec3::Zero()) << b.name;
@@ -111,7 +113,7 @@ TEST(NanGuard, NanForceStopsOnlyItsIsland) {
   }
   EXPECT_EQ(w.numericalEvents().size(), 1u);
   // The bad column stepped on after the event and still stands.
-  for (int k = 4; k <= 6; ++k) EXPECT_NEAR(w.body(BodyId{k}).position.y(), Real(0.5) + (k - 4), 0.02);
+  for (int k = 4; k <= 6; ++k) EXPECT_NEAR(cairn::detail::internals(w).body(BodyId{k}).position.y(), Real(0.5) + (k - 4), 0.02);
 }
 
 // A spring of 1e308 N/m stretched 10 m: its force overflows to infinity
@@ -133,11 +135,11 @@ TEST(NanGuard, InfiniteSpringForceIsStoppedEveryStep) {
   for (int s = 0; s < 30; ++s) {
     w.step(kH);
     ref.step(kH);
-    for (int k = 1; k <= 2; ++k) ASSERT_TRUE(sameState(w.body(BodyId{k}), ref.body(BodyId{k}))) << "step " << s;
+    for (int k = 1; k <= 2; ++k) ASSERT_TRUE(sameState(cairn::detail::internals(w).body(BodyId{k}), cairn::detail::internals(ref).body(BodyId{k}))) << "step " << s;
     ASSERT_EQ(w.numericalEvents().size(), static_cast<size_t>(s + 1));
     EXPECT_EQ(w.numericalEvents().back().body_name, "bob");
     EXPECT_EQ(w.numericalEvents().back().stage, "velocity integration");
-    EXPECT_EQ(w.body(bob).position, Vec3(10, 5, 0));
+    EXPECT_EQ(cairn::detail::internals(w).body(bob).position, Vec3(10, 5, 0));
     expectAllFinite(w);
   }
 }
@@ -156,7 +158,7 @@ TEST(NanGuard, OverflowingSpinIsCaughtAtPositionIntegration) {
   ASSERT_EQ(w.numericalEvents().size(), 1u);
   EXPECT_EQ(w.numericalEvents()[0].stage, "position integration");
   EXPECT_EQ(w.numericalEvents()[0].detail, "orientation");
-  EXPECT_EQ(w.body(id).position, Vec3(0, 5, 0));
+  EXPECT_EQ(cairn::detail::internals(w).body(id).position, Vec3(0, 5, 0));
   expectAllFinite(w);
 
   // The same spin with max_angular_velocity set: capped, nothing caught.
@@ -166,7 +168,7 @@ TEST(NanGuard, OverflowingSpinIsCaughtAtPositionIntegration) {
   const BodyId c = capped.createBody(d);
   capped.step(kH);
   EXPECT_TRUE(capped.numericalEvents().empty());
-  EXPECT_NEAR(capped.body(c).angular_velocity.norm(), 100, 1e-9);
+  EXPECT_NEAR(cairn::detail::internals(capped).body(c).angular_velocity.norm(), 100, 1e-9);
 }
 
 // A NaN first born inside the solve (finite rows, finite velocities, but
@@ -198,7 +200,7 @@ TEST(NanGuard, NanBornInTheSolveIsReportedThereAndContained) {
   for (int st = 0; st < 30; ++st) {
     w.step(kH);
     ref.step(kH);
-    ASSERT_TRUE(sameState(w.body(BodyId{1}), ref.body(BodyId{0}))) << "step " << st;
+    ASSERT_TRUE(sameState(cairn::detail::internals(w).body(BodyId{1}), cairn::detail::internals(ref).body(BodyId{0}))) << "step " << st;
   }
   ASSERT_FALSE(w.numericalEvents().empty());
   const NumericalEvent& e = w.numericalEvents()[0];
@@ -215,15 +217,15 @@ TEST(NanGuard, StateSetBetweenStepsIsRestored) {
   World w = groundWorld();
   const BodyId id = w.createBody(test::boxDef("box", Vec3(0, 3, 0)));
   for (int s = 0; s < 10; ++s) w.step(kH);
-  const Vec3 last = w.body(id).position;
-  w.body(id).position.x() = kNaN;
+  const Vec3 last = cairn::detail::internals(w).body(id).position;
+  cairn::detail::internals(w).body(id).position.x() = kNaN;
   w.step(kH);
   ASSERT_EQ(w.numericalEvents().size(), 1u);
   EXPECT_EQ(w.numericalEvents()[0].stage, "step start");
   EXPECT_EQ(w.numericalEvents()[0].detail, "position set between steps");
   // Restored at rest, then one step of free fall: y drops by g h^2.
-  EXPECT_EQ(w.body(id).position.x(), last.x());
-  EXPECT_NEAR(w.body(id).position.y(), last.y() - Real(9.81) * kH * kH, 1e-12);
+  EXPECT_EQ(cairn::detail::internals(w).body(id).position.x(), last.x());
+  EXPECT_NEAR(cairn::detail::internals(w).body(id).position.y(), last.y() - Real(9.81) * kH * kH, 1e-12);
   expectAllFinite(w);
 }
 
@@ -250,14 +252,14 @@ TEST(MaxCorrectionVelocity, CapsJointFeedbackAndTheJointStillCloses) {
     j.body_b = id;
     j.anchor = Vec3(0, 0, 0);
     w.createJoint(j);
-    Body& b = w.body(id);
+    Body& b = cairn::detail::internals(w).body(id);
     b.position = Vec3(6, -8, 0);  // 10 m off, not along an axis
     b.updateDerived();
     Real prev = 10;
     for (int st = 0; st < 180; ++st) {
       w.step(kH);
       Vec3 bias = Vec3::Zero();
-      for (const ConstraintRow& r : w.rows()) {
+      for (const ConstraintRow& r : cairn::detail::internals(w).expandedRows()) {
         if (r.kind != RowKind::JointLinear) continue;
         const Real target = r.correction == Correction::InRhs ? r.rhs : r.bias_rhs;
         bias += r.j_lin_b * target;  // rows along the world axes: the asked velocity vector
@@ -294,11 +296,11 @@ TEST(MaxCorrectionVelocity, LeavesSoftRowsAlone) {
   j.softness.erp = Real(0.5);
   j.softness.cfm = Real(1e-3);
   w.createJoint(j);
-  w.body(id).position = Vec3(5, 0, 0);
-  w.body(id).updateDerived();
+  cairn::detail::internals(w).body(id).position = Vec3(5, 0, 0);
+  cairn::detail::internals(w).body(id).updateDerived();
   w.step(kH);
   int checked = 0;
-  for (const ConstraintRow& r : w.rows()) {
+  for (const ConstraintRow& r : cairn::detail::internals(w).expandedRows()) {
     if (r.j_lin_b.x() == 0) continue;
     EXPECT_DOUBLE_EQ(r.rhs, -Real(0.5) / kH * 5);
     ++checked;
@@ -315,13 +317,13 @@ TEST(MaxAngularVelocity, OffByDefaultAndFromTheSceneFile) {
   EXPECT_FALSE(std::isfinite(def.solver.max_angular_velocity));
   World w0 = buildWorld(def);
   for (int s = 0; s < 10; ++s) w0.step(kH);
-  EXPECT_NEAR(w0.body(BodyId{0}).angular_velocity.y(), 1000, 1e-9);  // isotropic: no gyroscopic torque
+  EXPECT_NEAR(cairn::detail::internals(w0).body(BodyId{0}).angular_velocity.y(), 1000, 1e-9);  // isotropic: no gyroscopic torque
 
   SceneDesc capped = parseScene("{\"solver\": {\"max_angular_velocity\": 50}, " + body + "}", "capped.json");
   EXPECT_EQ(capped.solver.max_angular_velocity, 50);
   World w1 = buildWorld(capped);
   w1.step(kH);
-  EXPECT_NEAR(w1.body(BodyId{0}).angular_velocity.norm(), 50, 1e-9);
+  EXPECT_NEAR(cairn::detail::internals(w1).body(BodyId{0}).angular_velocity.norm(), 50, 1e-9);
   EXPECT_THROW(parseScene("{\"solver\": {\"max_angular_velocity\": 0}}", "bad.json"), InputError);
   EXPECT_THROW(parseScene("{\"solver\": {\"max_correction_velocity\": -1}}", "bad.json"), InputError);
 }

@@ -1,7 +1,7 @@
 // Shared helpers for the physics tests.
 #pragma once
 
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <string>
 

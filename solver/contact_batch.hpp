@@ -1,0 +1,97 @@
+// The compact contact constraint, laid out for wide solving.
+//
+// A contact manifold (one to four points between two bodies, one normal)
+// becomes one lane of a ContactBatch: eight manifolds side by side in
+// structure-of-arrays form (each field an array of kBatchLanes doubles), so
+// a kernel loads a field of four or eight manifolds with one vector load.
+// The layout is the same whatever the instruction set: the AVX-512 kernel
+// reads eight lanes at a time, the AVX2 kernel four, the portable kernel
+// one, and all do the same arithmetic per lane in the same order, so their
+// results are bit-identical (docs/performance.md, "Determinism").
+//
+// Per manifold only what the solver reads (Box2D v3's b2ContactConstraintSIMD
+// and Jolt's ContactConstraint keep the same): the two bodies, their inverse
+// masses and world inverse inertias (constant over the step), the normal,
+// and per point the anchors r_a, r_b (from each body's center of mass, world
+// frame), a tangent, the effective masses and the impulses. The Jacobian
+// and M^-1 J^T are formed on the fly from these: for a point with anchors
+// r_a, r_b and direction u,
+//
+//   J v      = u . (v_b + w_b x r_b - v_a - w_a x r_a)
+//   dv_a     = -m_a^-1 u dl,   dw_a = -I_a^-1 (r_a x u) dl   (and + for b)
+//
+// which costs a few more flops than reading a stored J and M^-1 J^T but
+// streams a third of the bytes; the solve is bound by memory, not flops.
+//
+// Normal rows of one manifold are solved together as a block (pgs.hpp
+// explains why): the block's matrix A_b = J_b M^-1 J_b^T + diag(cfm) and its
+// Cholesky factor L are stored per lane, padded to 4 x 4 with identity rows
+// for missing points. Friction is two tangent rows per point, t and n x t,
+// each bounded by mu lambda_n of its point (ODE's and Bullet's pyramid).
+#pragma once
+
+#include <cstdint>
+
+namespace cairn {
+
+inline constexpr int kBatchLanes = 8;
+inline constexpr int kMaxPoints = 4;
+
+struct alignas(64) ContactBatch {
+  using Lanes = double[kBatchLanes];
+  std::int32_t body_a[kBatchLanes];  // solver body indices
+  std::int32_t body_b[kBatchLanes];
+  std::int32_t island[kBatchLanes];  // island index per lane (NNCG's momentum is per island)
+  std::int32_t count[kBatchLanes];   // points in use (0 for a padding lane)
+
+  // Mass data, constant over the step. Inverse inertia is the symmetric
+  // world matrix (xx, yy, zz, xy, xz, yz); inverse mass per world axis
+  // (degree-of-freedom locks zero some).
+  Lanes ma[3], mb[3];
+  Lanes ia[6], ib[6];
+
+  Lanes n[3];  // normal, from a to b
+  Lanes mu;    // friction coefficient
+  Lanes cfm;   // impulse-form CFM of every row (ODE's CFM / h)
+
+  struct Point {
+    Lanes valid;            // 1 for a point in use, 0 for padding
+    Lanes ra[3], rb[3];     // anchors from the centers of mass, world
+    Lanes t[3];             // first tangent (the second is n x t)
+    Lanes rhs;              // velocity target of the normal row
+    Lanes bias;             // position-correction target (split impulse pass)
+    Lanes normal_mass;      // 1 / (A_ii + cfm)
+    Lanes lambda;           // accumulated normal impulse (warm-started)
+    Lanes lambda_bias;      // the correction pass's impulse, from zero each step
+    Lanes max_lambda;       // the largest normal impulse of the step (restitution acts only where it was > 0)
+    Lanes bounce;           // restitution's target normal velocity (-e times the approach speed), 0: no bounce
+    Lanes tangent_mass[2];  // 1 / (A_tt + cfm) for t and n x t
+    Lanes lambda_t[2];      // accumulated friction impulses along t and n x t
+    // NNCG (solver/pgs.hpp): this sweep's change of each impulse and the
+    // momentum direction.
+    Lanes change_n, change_t[2];
+    Lanes dir_n, dir_t[2];
+  } p[kMaxPoints];
+
+  // The normal block: A_b (row-major lower triangle: 00, 10, 11, 20, 21, 22,
+  // 30, 31, 32, 33) and its Cholesky factor in the same order.
+  Lanes block[10];
+  Lanes factor[10];
+
+  // Per lane, written by every sweep: the largest impulse change and the
+  // largest impulse (the per-island stopping test), and for NNCG the
+  // squared norm of the changes.
+  Lanes sweep_delta, sweep_lambda, change2;
+};
+
+// What a kernel sweep needs besides the batches.
+struct ContactSweepParams {
+  double sor = 1;
+  int dynamic_end = 1;  // solver bodies [1, dynamic_end) may be written; 0 (the world) and the rest are read only
+  bool gather_change = false;  // NNCG: record each row's change and the lane's squared norm
+  // Per island: 1 while its sweeps go on, 0 once it has stopped (its lanes
+  // are left as they are). Null: every island goes on.
+  const double* island_active = nullptr;
+};
+
+}  // namespace cairn

@@ -1,0 +1,58 @@
+// The contact solver's inner loops, one set per instruction set: portable
+// (one lane at a time, any CPU), AVX2 (four doubles) and AVX-512 (eight).
+// Each set is compiled in its own translation unit with its own target
+// flags (solver/contact_kernels_*.cpp) from the one template in
+// contact_kernel_impl.hpp; the engine picks a set at run time from what the
+// CPU supports (SolverSettings::simd), so one binary runs everywhere and
+// uses the widest set it can. All sets give bit-identical results: the
+// arithmetic per lane is the same and no floating-point contraction is
+// allowed (-ffp-contract=off), so a wider set only does more lanes at once.
+//
+// Every function works on the batches [begin, end) of one colour (no two
+// lanes of a colour share a dynamic body, so lanes never race) and may run
+// on several threads over disjoint ranges.
+#pragma once
+
+#include "solver/contact_batch.hpp"
+
+namespace cairn {
+
+// `bodies` points at the solver bodies' velocities: 8 doubles per body,
+// v at [0, 3) and w at [3, 6) (solver/solver_body.hpp).
+struct ContactKernels {
+  const char* name;
+  int lanes;  // doubles per vector
+  // Adds M^-1 J^T lambda of the carried impulses (normal and friction).
+  void (*warm_start)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
+  // One projected Gauss-Seidel visit of every manifold: the normal block,
+  // then the two friction rows of each point.
+  // Each lane records its largest change and impulse in sweep_delta and
+  // sweep_lambda (and, with gather_change, NNCG's changes).
+  void (*solve)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
+  // NNCG's momentum step (pgs.hpp): lambda += beta p projected on the
+  // bounds, with beta per island (beta == 0: p = this sweep's change, no
+  // step; beta > 1: restart, p = 0; beta < 0: the island has stopped,
+  // nothing changes).
+  void (*momentum)(ContactBatch* batches, int begin, int end, double* bodies, const double* island_beta,
+                   const ContactSweepParams& p);
+  // The split-impulse correction pass: normal blocks toward the bias
+  // targets, on the pseudo-velocities, from lambda_bias.
+  void (*solve_bias)(ContactBatch* batches, int begin, int end, double* pseudo, const ContactSweepParams& p);
+  // Restitution, once per step after the solve: each manifold's points
+  // that carried a normal impulse and approached faster than the threshold
+  // are driven to their bounce velocity (the others to no approach), by
+  // projected sweeps on the normal block.
+  void (*restitution)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
+};
+
+enum class SimdLevel { Portable, Avx2, Avx512 };
+
+// The kernels of one level; throws std::invalid_argument if the level was
+// not built into this library or the CPU lacks it.
+const ContactKernels& contactKernels(SimdLevel level);
+// The widest level built in and supported by this CPU.
+SimdLevel bestSimdLevel();
+bool simdLevelAvailable(SimdLevel level);
+const char* simdLevelName(SimdLevel level);
+
+}  // namespace cairn

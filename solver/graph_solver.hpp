@@ -1,0 +1,113 @@
+// Projected Gauss-Seidel over a coloured constraint graph: the step's
+// velocity solve for every island solved by PGS. Islands share the sweeps
+// but not their results: each island stops on its own (at the round-off
+// fixed point or the tolerance) and has its own NNCG momentum, so an island
+// steps exactly as it would alone.
+//
+// The constraints are of two kinds: contact manifolds, in the compact
+// ContactBatch form solved by the wide kernels (contact_kernels.hpp), and
+// row groups, the generic rows of one joint (or of a contact with rolling
+// friction) solved in order one row at a time (ODE's quickstep row:
+// pgs.hpp). Every constraint has a colour, and no two constraints of one
+// colour share a dynamic body (Box2D v3's graph colouring, solver.c and
+// constraint_graph.c): the constraints of a colour can be solved in any
+// order, by vector lanes or by threads, with the same result. A sweep
+// visits the colours in order (or, with randomize_order, in a seeded
+// shuffled order), so the Gauss-Seidel order, and the result, depend only on
+// the colouring, never on the instruction set or the thread count.
+//
+// Around the sweeps, as in pgs.hpp: warm start; NNCG momentum between
+// sweeps with one beta per island (islands are independent problems);
+// a stop at the round-off fixed point or the tolerance; then the
+// position-correction passes from zero impulses (Baumgarte rows on the
+// velocities, split-impulse rows on the pseudo-velocities); and, once per
+// step, restitution.
+#pragma once
+
+#include "constraints/row.hpp"
+#include "solver/contact_batch.hpp"
+#include "solver/contact_kernels.hpp"
+#include "solver/solver_body.hpp"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace cairn {
+
+class WorkerPool;
+
+// The rows [begin, end) of one joint, solved in order; friction rows'
+// normal_row counts from `begin`.
+struct RowGroup {
+  std::int32_t begin = 0, end = 0;
+  std::int32_t island = 0;
+};
+
+struct GraphColour {
+  std::int32_t batch_begin = 0, batch_end = 0;  // ContactBatch range
+  std::int32_t group_begin = 0, group_end = 0;  // RowGroup range
+};
+
+// One step's PGS problem, rebuilt by the step each (sub)step; vectors keep
+// their capacity, so nothing is allocated once the scene has warmed up.
+struct GraphProblem {
+  std::vector<ContactBatch> batches;  // by colour
+  std::vector<RowGroup> groups;       // by colour
+  std::vector<ConstraintRow> rows;    // the groups' rows
+  std::vector<GraphColour> colours;
+  int island_count = 0;
+
+  // Scratch, sized by the solver.
+  std::vector<Real> row_change, row_dir, row_bias_lambda;
+  std::vector<Real> group_delta, group_lambda;  // per group: this sweep's largest change and impulse
+  std::vector<double> island_norm2, island_prev_norm2, island_beta;
+  std::vector<double> island_active;            // 1 while the island's sweeps go on
+  std::vector<double> island_delta, island_lambda;
+  std::vector<int> island_iterations;
+  std::vector<std::int32_t> colour_order;
+
+  void clear() {
+    batches.clear();
+    groups.clear();
+    rows.clear();
+    colours.clear();
+    island_count = 0;
+  }
+  bool empty() const { return batches.empty() && groups.empty(); }
+};
+
+struct GraphSolveOptions {
+  int iterations = 10;
+  Real tolerance = 0;
+  Real sor = 1;
+  bool nncg = true;
+  bool randomize_order = false;
+  int dynamic_end = 1;  // solver bodies [1, dynamic_end) may be written (0 is the world)
+  const ContactKernels* kernels = nullptr;
+  WorkerPool* pool = nullptr;  // null: this thread only
+};
+
+struct GraphSolveStats {
+  int iterations = 0;       // the most sweeps any island took
+  Real last_max_delta = 0;  // the largest impulse change of the islands' last sweeps
+};
+
+// Warm start and the velocity sweeps.
+GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const GraphSolveOptions& o,
+                           std::uint64_t& rng_state);
+
+// The position-correction passes from zero impulses: rows whose correction
+// is VelocityBias on `bodies`, then split-impulse rows (contact normals and
+// PseudoVelocity joint rows) on `pseudo` (zeroed by the caller). Returns
+// false when there was nothing to correct on the pseudo-velocities (then
+// they stay zero).
+bool solveGraphCorrection(GraphProblem& p, std::span<SolverBody> bodies, std::span<SolverBody> pseudo,
+                          const GraphSolveOptions& o);
+
+// Restitution of the contacts that bounce, once per step after the last
+// substep's solve (Box2D v3's b2ApplyRestitution, with the block of
+// contact_kernels.hpp).
+void solveGraphRestitution(GraphProblem& p, std::span<SolverBody> bodies, const GraphSolveOptions& o);
+
+}  // namespace cairn

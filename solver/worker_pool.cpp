@@ -1,0 +1,75 @@
+#include "solver/worker_pool.hpp"
+
+namespace cairn {
+
+namespace {
+thread_local int t_thread_index = 0;
+
+// Spins this many times on an atomic before blocking on it: a loop of the
+// step usually arrives within a few microseconds of the last one.
+constexpr int kSpins = 4000;
+
+inline void pause() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+}  // namespace
+
+WorkerPool::WorkerPool(int threads) : threads_(threads < 1 ? 1 : threads) {
+  workers_.reserve(static_cast<size_t>(threads_ - 1));
+  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this, i] { workerLoop(i); });
+}
+
+WorkerPool::~WorkerPool() {
+  stop_.store(true, std::memory_order_release);
+  generation_.fetch_add(1, std::memory_order_acq_rel);
+  generation_.notify_all();
+  for (auto& t : workers_) t.join();
+}
+
+int WorkerPool::currentThread() { return t_thread_index; }
+
+void WorkerPool::doChunk(const Job& job, int chunk) {
+  // Chunk c covers [c n / k, (c + 1) n / k): contiguous and balanced.
+  const long n = job.count, k = job.chunks;
+  const int begin = static_cast<int>(chunk * n / k), end = static_cast<int>((chunk + 1) * n / k);
+  if (end > begin) job.call(job.ctx, begin, end);
+}
+
+void WorkerPool::run(const Job& job) {
+  job_ = job;
+  // Every worker reports back, busy or not, so none still reads job_ when
+  // the next loop overwrites it.
+  remaining_.store(threads_ - 1, std::memory_order_relaxed);
+  generation_.fetch_add(1, std::memory_order_acq_rel);
+  generation_.notify_all();
+  doChunk(job_, 0);
+  for (int spin = 0; remaining_.load(std::memory_order_acquire) != 0; ++spin) {
+    if (spin < kSpins) pause();
+    else std::this_thread::yield();
+  }
+}
+
+void WorkerPool::workerLoop(int index) {
+  t_thread_index = index;
+  std::uint64_t seen = generation_.load(std::memory_order_acquire);
+  for (;;) {
+    std::uint64_t now = generation_.load(std::memory_order_acquire);
+    for (int spin = 0; now == seen && spin < kSpins; ++spin) {
+      pause();
+      now = generation_.load(std::memory_order_acquire);
+    }
+    if (now == seen) {
+      generation_.wait(seen, std::memory_order_acquire);
+      continue;
+    }
+    seen = now;
+    if (stop_.load(std::memory_order_acquire)) return;
+    const Job job = job_;
+    if (index < job.chunks) doChunk(job, index);
+    remaining_.fetch_sub(1, std::memory_order_acq_rel);
+  }
+}
+
+}  // namespace cairn

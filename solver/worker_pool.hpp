@@ -1,0 +1,75 @@
+// A small pool of worker threads for the step's parallel loops.
+//
+// The step splits its work into loops whose items are independent (the
+// constraints of one graph colour, the bodies to integrate, the pairs to
+// collide), many of them a few microseconds long, with a barrier after
+// each. A general task scheduler (oneTBB's parallel_for) costs a few
+// microseconds per loop for its task bookkeeping, as much as the small
+// loops themselves; Box2D v3 and Jolt keep their workers spinning between
+// stages for the same reason. So: persistent workers, a loop handed over
+// through one atomic generation counter, contiguous static chunks (no
+// stealing: the items of a loop cost about the same), and a spin-then-wait
+// barrier. Results never depend on the split: every loop writes disjoint
+// data, and the reductions the step needs are done afterwards in a fixed
+// order (docs/performance.md, "Threads").
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <thread>
+#include <type_traits>
+#include <vector>
+
+namespace cairn {
+
+class WorkerPool {
+ public:
+  // `threads` >= 1 counts the calling thread: threads - 1 workers start.
+  explicit WorkerPool(int threads);
+  ~WorkerPool();
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  int threads() const { return threads_; }
+  // 0 on the thread that calls parallelFor, 1 .. threads - 1 on the workers.
+  static int currentThread();
+
+  // Calls fn(begin, end) on contiguous chunks of [0, count), one per thread
+  // (fewer when count is small), and returns when all are done. Not
+  // re-entrant: fn must not call parallelFor.
+  template <class F>
+  void parallelFor(int count, F&& fn) {
+    if (count <= 0) return;
+    const int chunks = count < threads_ ? count : threads_;
+    if (chunks == 1) {
+      fn(0, count);
+      return;
+    }
+    Job job;
+    job.count = count;
+    job.chunks = chunks;
+    using Fn = std::remove_reference_t<F>;
+    job.ctx = const_cast<void*>(static_cast<const void*>(&fn));
+    job.call = [](void* ctx, int b, int e) { (*static_cast<Fn*>(ctx))(b, e); };
+    run(job);
+  }
+
+ private:
+  struct Job {
+    int count = 0, chunks = 0;
+    void* ctx = nullptr;
+    void (*call)(void*, int, int) = nullptr;
+  };
+  void run(const Job& job);
+  void workerLoop(int index);
+  void doChunk(const Job& job, int chunk);
+
+  int threads_;
+  std::vector<std::thread> workers_;
+  Job job_;
+  std::atomic<std::uint64_t> generation_{0};
+  std::atomic<int> remaining_{0};
+  std::atomic<bool> stop_{false};
+};
+
+}  // namespace cairn

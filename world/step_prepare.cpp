@@ -1,0 +1,551 @@
+// Stages 3 (solver order) and 5 (prepare) of the step.
+//
+// Solver order: the awake dynamic bodies island by island, then the
+// kinematic bodies, then one static body standing for the world and every
+// static or sleeping body (solver/solver_body.hpp).
+//
+// Prepare: every constraint of an awake island becomes solver data for this
+// substep. Islands solved by PGS go into the constraint graph
+// (solver/graph_solver.hpp): each contact manifold as one lane of a
+// ContactBatch, each joint (and each contact with rolling or torsional
+// friction) as a group of generic rows. Islands solved directly or exactly
+// get generic rows, island by island, as those solvers read them.
+//
+// The graph's colours are a wavefront schedule of one sequential
+// Gauss-Seidel order. The constraints are sorted by level, the distance of
+// their bodies from the static world in the constraint graph (joints before
+// contacts, then creation order, within a level), which is the order that
+// carries a stack's weight from the ground up in one sweep (Erleben,
+// "Velocity-based shock propagation for multibody dynamics animation", ACM
+// TOG 26(2), 2007, orders by the same levels). Each constraint then gets the
+// colour one past the latest colour of any constraint before it that shares
+// a dynamic body. Constraints of one colour share no dynamic body, so they
+// can be solved by vector lanes and threads at once, and the sweep over the
+// colours in order gives exactly the sequential Gauss-Seidel result of the
+// sorted order: the wide and threaded solves lose none of its convergence
+// (Box2D v3 colours greedily instead, with fewer colours but red-black
+// order, which a 10-box column at 10 sweeps does not forgive;
+// docs/performance.md measures both).
+#include "world/step_stages.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cairn::detail {
+
+namespace {
+
+using Item = GraphItem;
+
+BodyView solverView(const WorldImpl& w, const StepContext& ctx, BodyId id) {
+  BodyView v = w.view(id);
+  v.solver_index = id.isWorld() ? ctx.static_index : ctx.solver_of_body[static_cast<size_t>(id.index)];
+  return v;
+}
+
+std::int32_t islandOf(const StepContext& ctx, BodyId a, BodyId b) {
+  const std::int32_t ia = a.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(a.index)];
+  return ia >= 0 ? ia : (b.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(b.index)]);
+}
+
+bool usesRowGroup(const Contact& c) { return c.rolling_friction > 0 || c.torsional_friction > 0; }
+
+// The symmetric matrix as the kernels store it: xx, yy, zz, xy, xz, yz.
+void storeSym(double (*dst)[kBatchLanes], int lane, const Mat3& m) {
+  dst[0][lane] = m(0, 0);
+  dst[1][lane] = m(1, 1);
+  dst[2][lane] = m(2, 2);
+  dst[3][lane] = m(0, 1);
+  dst[4][lane] = m(0, 2);
+  dst[5][lane] = m(1, 2);
+}
+
+void store3(double (*dst)[kBatchLanes], int lane, const Vec3& v) {
+  for (int k = 0; k < 3; ++k) dst[k][lane] = v[k];
+}
+
+int tri(int i, int j) { return i * (i + 1) / 2 + j; }
+
+// Cholesky factor of the block A_b + eps I, eps = 1e-12 of its largest
+// diagonal: a face manifold's A_b is singular (4 coplanar points fix 3
+// motions), and the regularisation picks, among the impulses that give the
+// same motion, one of least norm (pgs.cpp's factorBlock).
+void factorBlock(const Real* a, Real* l) {
+  Real top = 0;
+  for (int i = 0; i < 4; ++i) top = std::max(top, a[tri(i, i)]);
+  const Real eps = Real(1e-12) * top;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j <= i; ++j) {
+      Real sum = a[tri(i, j)] + (i == j ? eps : Real(0));
+      for (int k = 0; k < j; ++k) sum -= l[tri(i, k)] * l[tri(j, k)];
+      l[tri(i, j)] = i == j ? std::sqrt(std::max(sum, eps)) : sum / l[tri(j, j)];
+    }
+}
+
+struct ContactParams {
+  Real h = 0, cfm = 0, contact_erp = 0, slop = 0, threshold = 0, max_correction = 0, warm = 0;
+  Correction correction = Correction::PseudoVelocity;
+  bool first_substep = true;
+};
+
+// One manifold into one lane (contact_batch.hpp lists the fields).
+void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a, const BodyView& b,
+              std::int32_t island, const ContactParams& cp, bool& pushing) {
+  batch.body_a[lane] = a.solver_index;
+  batch.body_b[lane] = b.solver_index;
+  batch.island[lane] = island;
+  batch.count[lane] = c.count;
+  const Vec3 ma = a.inv_mass * a.lin_factor, mb = b.inv_mass * b.lin_factor;
+  store3(batch.ma, lane, ma);
+  store3(batch.mb, lane, mb);
+  storeSym(batch.ia, lane, a.inv_inertia);
+  storeSym(batch.ib, lane, b.inv_inertia);
+  const Vec3& n = c.normal;
+  store3(batch.n, lane, n);
+  batch.mu[lane] = c.friction;
+  batch.cfm[lane] = cp.cfm;
+  const Real lin = n.dot(ma.cwiseProduct(n)) + n.dot(mb.cwiseProduct(n));
+
+  Vec3 ran[kMaxPoints], rbn[kMaxPoints];
+  bool valid[kMaxPoints] = {};
+  for (int i = 0; i < kMaxPoints; ++i) {
+    ContactBatch::Point& q = batch.p[i];
+    q.valid[lane] = 0;
+    q.lambda[lane] = q.lambda_t[0][lane] = q.lambda_t[1][lane] = 0;
+    q.max_lambda[lane] = q.lambda_bias[lane] = 0;
+    q.rhs[lane] = q.bias[lane] = q.bounce[lane] = 0;
+    q.normal_mass[lane] = q.tangent_mass[0][lane] = q.tangent_mass[1][lane] = 0;
+    q.change_n[lane] = q.change_t[0][lane] = q.change_t[1][lane] = 0;
+    q.dir_n[lane] = q.dir_t[0][lane] = q.dir_t[1][lane] = 0;
+    for (int k = 0; k < 3; ++k) q.ra[k][lane] = q.rb[k][lane] = q.t[k][lane] = 0;
+    ran[i] = rbn[i] = Vec3::Zero();
+    if (i >= c.count) continue;
+    const ContactPointState& s = c.points[i];
+    const Vec3 pa = worldPoint(a, s.local_a), pb = worldPoint(b, s.local_b);
+    const Vec3 ra = pa - a.x, rb = pb - b.x;
+    ran[i] = ra.cross(n);
+    rbn[i] = rb.cross(n);
+    const Real k = lin + ran[i].dot(a.inv_inertia * ran[i]) + rbn[i].dot(b.inv_inertia * rbn[i]);
+    if (!(k > 0)) continue;  // neither body can move along the normal here (locks)
+    valid[i] = true;
+    q.valid[lane] = 1;
+    store3(q.ra, lane, ra);
+    store3(q.rb, lane, rb);
+    q.normal_mass[lane] = 1 / (k + cp.cfm);
+
+    // Targets: close a gap within the step and no more (speculative); push
+    // the penetration beyond the slop out at contact_erp / h.
+    const Real sep = (pb - pa).dot(n);
+    const Real push = sep > 0 ? 0 : std::clamp(cp.contact_erp / cp.h * (-sep - cp.slop), Real(0), cp.max_correction);
+    Real rhs = sep > 0 ? -sep / cp.h : Real(0);
+    if (cp.correction == Correction::InRhs) {
+      rhs = std::max(rhs, push);
+    } else {
+      // Every point of the manifold takes part in the correction pass
+      // (target 0 within the slop, -gap/h while separated), so pushing one
+      // corner out lifts the body instead of tipping it.
+      q.bias[lane] = sep > 0 ? -sep / cp.h : push;
+      pushing = pushing || push > 0;
+    }
+    q.rhs[lane] = rhs;
+    // Restitution: the approach speed at detection, before this step's
+    // forces, applied once after the solve (applyRestitution).
+    if (c.restitution > 0 && -s.approach_speed > cp.threshold) q.bounce[lane] = -c.restitution * s.approach_speed;
+    q.max_lambda[lane] = cp.first_substep ? Real(0) : s.max_impulse;
+
+    // Friction: the first tangent along the sliding direction when sliding,
+    // so the pyramid's corners do not favour axes; otherwise along the
+    // carried friction impulse, else any perpendicular.
+    const Vec3 vrel = (b.v + b.w.cross(rb)) - (a.v + a.w.cross(ra));
+    const Vec3 vt = vrel - n * n.dot(vrel);
+    const Vec3 carried = s.friction_impulse - n * n.dot(s.friction_impulse);
+    Vec3 t1;
+    if (vt.norm() > Real(1e-3)) t1 = vt.normalized();
+    else if (carried.norm() > Real(1e-12)) t1 = carried.normalized();
+    else t1 = anyPerpendicular(n);
+    const Vec3 t2 = n.cross(t1);
+    store3(q.t, lane, t1);
+    if (c.friction > 0) {
+      for (int k2 = 0; k2 < 2; ++k2) {
+        const Vec3 t = k2 == 0 ? t1 : t2;
+        const Vec3 rat = ra.cross(t), rbt = rb.cross(t);
+        const Real kt = t.dot(ma.cwiseProduct(t)) + t.dot(mb.cwiseProduct(t)) + rat.dot(a.inv_inertia * rat) +
+                        rbt.dot(b.inv_inertia * rbt);
+        q.tangent_mass[k2][lane] = kt + cp.cfm > 0 ? 1 / (kt + cp.cfm) : 0;
+        q.lambda_t[k2][lane] = cp.warm * s.friction_impulse.dot(t);
+      }
+    }
+    q.lambda[lane] = cp.warm * s.normal_impulse;
+  }
+
+  // The normal block, padded to 4 x 4 with identity rows.
+  Real blk[10], fac[10];
+  for (int i = 0; i < kMaxPoints; ++i)
+    for (int j = 0; j <= i; ++j) {
+      Real v;
+      if (valid[i] && valid[j])
+        v = lin + ran[i].dot(a.inv_inertia * ran[j]) + rbn[i].dot(b.inv_inertia * rbn[j]) + (i == j ? cp.cfm : Real(0));
+      else
+        v = i == j ? Real(1) : Real(0);
+      blk[tri(i, j)] = v;
+    }
+  factorBlock(blk, fac);
+  for (int k = 0; k < 10; ++k) {
+    batch.block[k][lane] = blk[k];
+    batch.factor[k][lane] = fac[k];
+  }
+  batch.sweep_delta[lane] = batch.sweep_lambda[lane] = batch.change2[lane] = 0;
+}
+
+// An empty lane: the static body on both sides, no points.
+void padLane(ContactBatch& batch, int lane, std::int32_t static_index) {
+  batch.body_a[lane] = batch.body_b[lane] = static_index;
+  batch.island[lane] = 0;
+  batch.count[lane] = 0;
+  for (int k = 0; k < 3; ++k) batch.ma[k][lane] = batch.mb[k][lane] = batch.n[k][lane] = 0;
+  for (int k = 0; k < 6; ++k) batch.ia[k][lane] = batch.ib[k][lane] = 0;
+  batch.mu[lane] = batch.cfm[lane] = 0;
+  for (ContactBatch::Point& q : batch.p) {
+    q.valid[lane] = 0;
+    for (int k = 0; k < 3; ++k) q.ra[k][lane] = q.rb[k][lane] = q.t[k][lane] = 0;
+    q.rhs[lane] = q.bias[lane] = q.normal_mass[lane] = q.lambda[lane] = q.lambda_bias[lane] = 0;
+    q.max_lambda[lane] = q.bounce[lane] = 0;
+    q.tangent_mass[0][lane] = q.tangent_mass[1][lane] = q.lambda_t[0][lane] = q.lambda_t[1][lane] = 0;
+    q.change_n[lane] = q.change_t[0][lane] = q.change_t[1][lane] = 0;
+    q.dir_n[lane] = q.dir_t[0][lane] = q.dir_t[1][lane] = 0;
+  }
+  for (int k = 0; k < 10; ++k) {
+    batch.block[k][lane] = (k == 0 || k == 2 || k == 5 || k == 9) ? 1 : 0;
+    batch.factor[k][lane] = batch.block[k][lane];
+  }
+  batch.sweep_delta[lane] = batch.sweep_lambda[lane] = batch.change2[lane] = 0;
+}
+
+}  // namespace
+
+void orderSolverBodies(WorldImpl& w, StepContext& ctx) {
+  const size_t n = w.bodies_.size();
+  // Counting sort of the awake dynamic bodies by island, in body order.
+  ctx.island_first_body.assign(static_cast<size_t>(ctx.island_count) + 1, 0);
+  for (size_t i = 0; i < n; ++i)
+    if (ctx.body_island[i] >= 0) ++ctx.island_first_body[static_cast<size_t>(ctx.body_island[i]) + 1];
+  for (size_t k = 1; k < ctx.island_first_body.size(); ++k) ctx.island_first_body[k] += ctx.island_first_body[k - 1];
+  for (std::int32_t& first : ctx.island_first_body) ++first;  // index 0 is the world
+  ctx.dynamic_count = ctx.island_first_body.back() - 1;
+  int kinematic = 0;
+  for (const Body& b : w.bodies_)
+    if (b.alive && b.type == BodyType::Kinematic) ++kinematic;
+  ctx.solver_count = 1 + ctx.dynamic_count + kinematic;
+  ctx.solver_of_body.assign(n, ctx.static_index);
+  ctx.body_of_solver.assign(static_cast<size_t>(ctx.solver_count), -1);
+  ctx.island_fill.assign(ctx.island_first_body.begin(), ctx.island_first_body.end() - 1);
+  std::int32_t next_kinematic = 1 + ctx.dynamic_count;
+  for (size_t i = 0; i < n; ++i) {
+    const Body& b = w.bodies_[i];
+    std::int32_t si = -1;
+    if (ctx.body_island[i] >= 0) si = ctx.island_fill[static_cast<size_t>(ctx.body_island[i])]++;
+    else if (b.alive && b.type == BodyType::Kinematic) si = next_kinematic++;
+    if (si < 0) continue;
+    ctx.solver_of_body[i] = si;
+    ctx.body_of_solver[static_cast<size_t>(si)] = static_cast<std::int32_t>(i);
+  }
+  ctx.velocities.resize(static_cast<size_t>(ctx.solver_count));
+  ctx.pseudo.resize(ctx.velocities.size());
+}
+
+void prepareConstraints(WorldImpl& w, StepContext& ctx) {
+  const SolverSettings& s = w.settings_;
+  const Real h = ctx.hs;
+  const bool first_substep = ctx.substep == 0;
+
+  // The solver bodies' velocities, from the bodies.
+  for (std::int32_t si = 1; si < ctx.solver_count; ++si) {
+    const Body& b = w.bodies_[static_cast<size_t>(ctx.body_of_solver[static_cast<size_t>(si)])];
+    ctx.velocities[static_cast<size_t>(si)] = SolverBody{b.linear_velocity, b.angular_velocity};
+  }
+  ctx.velocities[static_cast<size_t>(ctx.static_index)] = SolverBody{};
+
+  GraphProblem& g = ctx.graph;
+  g.clear();
+  g.island_count = ctx.island_count;
+  ctx.rows.clear();
+  ctx.island_rows.assign(static_cast<size_t>(ctx.island_count), {0, 0});
+  ctx.lane_contact.clear();
+  ctx.group_joint.clear();
+  for (int& k : w.stats_.rows_by_kind) k = 0;
+
+  const auto live = [&](std::int32_t isl) { return isl >= 0 && !ctx.frozen_island[static_cast<size_t>(isl)]; };
+  const auto pgs = [&](std::int32_t isl) { return ctx.island_method[static_cast<size_t>(isl)] == SolverMethod::PGS; };
+
+  // 1. The island of every joint and contact.
+  ctx.joint_island.assign(w.joints_.size(), -1);
+  for (size_t i = 0; i < w.joints_.size(); ++i) {
+    const Joint& j = w.joints_[i];
+    if (j.alive && !j.broken) ctx.joint_island[i] = islandOf(ctx, j.def.body_a, j.def.body_b);
+  }
+  ctx.contact_island.assign(w.contacts_.size(), -1);
+  for (size_t i = 0; i < w.contacts_.size(); ++i) {
+    const Contact& c = w.contacts_[i];
+    if (c.enabled && c.count > 0) ctx.contact_island[i] = islandOf(ctx, c.body_a, c.body_b);
+  }
+
+  // 2. The PGS islands' constraints, and each dynamic body's level: its
+  // distance, in constraints, from a static or kinematic body (breadth
+  // first from the bodies that touch one; a floating island from its first
+  // body).
+  std::vector<Item>& items = ctx.items;
+  items.clear();
+  for (size_t i = 0; i < w.joints_.size(); ++i) {
+    const std::int32_t isl = ctx.joint_island[i];
+    if (!live(isl) || !pgs(isl)) continue;
+    const Joint& j = w.joints_[i];
+    items.push_back({Item::JointGroup, static_cast<std::int32_t>(i), solverView(w, ctx, j.def.body_a).solver_index,
+                     solverView(w, ctx, j.def.body_b).solver_index, isl});
+  }
+  for (size_t i = 0; i < w.contacts_.size(); ++i) {
+    const std::int32_t isl = ctx.contact_island[i];
+    if (!live(isl) || !pgs(isl)) continue;
+    const Contact& c = w.contacts_[i];
+    const Item::Kind kind = usesRowGroup(c) ? Item::ContactGroup : Item::Manifold;
+    items.push_back({kind, static_cast<std::int32_t>(i), solverView(w, ctx, c.body_a).solver_index,
+                     solverView(w, ctx, c.body_b).solver_index, isl});
+  }
+  const std::int32_t dyn = ctx.dynamic_count + 1;  // the solver indices below this, but 0, are dynamic
+  const auto isDyn = [&](std::int32_t si) { return si > 0 && si < dyn; };
+
+  // Adjacency in compressed rows over the dynamic solver bodies.
+  std::vector<std::int32_t>&adj_start = ctx.adj_start, &adj = ctx.adj, &level = ctx.level, &queue = ctx.queue;
+  adj_start.assign(static_cast<size_t>(dyn) + 1, 0);
+  for (const Item& it : items)
+    if (isDyn(it.a) && isDyn(it.b)) {
+      ++adj_start[static_cast<size_t>(it.a) + 1];
+      ++adj_start[static_cast<size_t>(it.b) + 1];
+    }
+  for (size_t k = 1; k < adj_start.size(); ++k) adj_start[k] += adj_start[k - 1];
+  adj.resize(static_cast<size_t>(adj_start.back()));
+  ctx.island_fill.assign(adj_start.begin(), adj_start.end() - 1);
+  for (const Item& it : items)
+    if (isDyn(it.a) && isDyn(it.b)) {
+      adj[static_cast<size_t>(ctx.island_fill[static_cast<size_t>(it.a)]++)] = it.b;
+      adj[static_cast<size_t>(ctx.island_fill[static_cast<size_t>(it.b)]++)] = it.a;
+    }
+  level.assign(static_cast<size_t>(dyn), -1);
+  queue.clear();
+  for (const Item& it : items) {  // grounded bodies first
+    const bool a_dyn = isDyn(it.a), b_dyn = isDyn(it.b);
+    if (a_dyn == b_dyn) continue;
+    const std::int32_t d = a_dyn ? it.a : it.b;
+    if (level[static_cast<size_t>(d)] < 0) {
+      level[static_cast<size_t>(d)] = 0;
+      queue.push_back(d);
+    }
+  }
+  const auto bfs = [&](size_t head) {
+    for (; head < queue.size(); ++head) {
+      const std::int32_t u = queue[head];
+      for (std::int32_t k = adj_start[static_cast<size_t>(u)]; k < adj_start[static_cast<size_t>(u) + 1]; ++k) {
+        const std::int32_t v = adj[static_cast<size_t>(k)];
+        if (level[static_cast<size_t>(v)] < 0) {
+          level[static_cast<size_t>(v)] = level[static_cast<size_t>(u)] + 1;
+          queue.push_back(v);
+        }
+      }
+    }
+    return head;
+  };
+  size_t head = bfs(0);
+  for (std::int32_t si = 1; si < dyn; ++si)  // floating islands
+    if (level[static_cast<size_t>(si)] < 0) {
+      level[static_cast<size_t>(si)] = 0;
+      queue.push_back(si);
+      head = bfs(head);
+    }
+
+  // 3. Sort by level (joints before contacts within a level, then creation
+  // order: `items` is in that order already, so a stable counting sort).
+  const auto itemLevel = [&](const Item& it) {
+    const std::int32_t la = isDyn(it.a) ? level[static_cast<size_t>(it.a)] : 0;
+    const std::int32_t lb = isDyn(it.b) ? level[static_cast<size_t>(it.b)] : 0;
+    return std::max(la, lb);
+  };
+  std::vector<Item>& sorted = ctx.sorted_items;
+  std::vector<std::int32_t>& level_start = ctx.level_start;
+  std::int32_t max_level = 0;
+  for (const Item& it : items) max_level = std::max(max_level, itemLevel(it));
+  level_start.assign(static_cast<size_t>(max_level) + 2, 0);
+  for (const Item& it : items) ++level_start[static_cast<size_t>(itemLevel(it)) + 1];
+  for (size_t k = 1; k < level_start.size(); ++k) level_start[k] += level_start[k - 1];
+  sorted.resize(items.size());
+  for (const Item& it : items) sorted[static_cast<size_t>(level_start[static_cast<size_t>(itemLevel(it))]++)] = it;
+
+  // 4. Colours: one past the latest colour of the constraints before that
+  // share a dynamic body.
+  std::vector<std::int32_t>& last_colour = ctx.last_colour;
+  last_colour.assign(static_cast<size_t>(dyn), -1);
+  ctx.colour_of.resize(sorted.size());
+  std::int32_t colours = 0;
+  for (size_t k = 0; k < sorted.size(); ++k) {
+    const Item& it = sorted[k];
+    std::int32_t c = 0;
+    if (isDyn(it.a)) c = std::max(c, last_colour[static_cast<size_t>(it.a)] + 1);
+    if (isDyn(it.b)) c = std::max(c, last_colour[static_cast<size_t>(it.b)] + 1);
+    if (isDyn(it.a)) last_colour[static_cast<size_t>(it.a)] = c;
+    if (isDyn(it.b)) last_colour[static_cast<size_t>(it.b)] = c;
+    ctx.colour_of[k] = c;
+    colours = std::max(colours, c + 1);
+  }
+
+  // 5. Layout: per colour its row groups, then its manifolds in batches of 8.
+  std::vector<std::int32_t>&groups_in = ctx.groups_in, &manifolds_in = ctx.manifolds_in;
+  groups_in.assign(static_cast<size_t>(colours), 0);
+  manifolds_in.assign(static_cast<size_t>(colours), 0);
+  for (size_t k = 0; k < sorted.size(); ++k)
+    (sorted[k].kind == Item::Manifold ? manifolds_in : groups_in)[static_cast<size_t>(ctx.colour_of[k])]++;
+  g.colours.resize(static_cast<size_t>(colours));
+  std::int32_t batch_at = 0, group_at = 0;
+  for (std::int32_t c = 0; c < colours; ++c) {
+    GraphColour& gc = g.colours[static_cast<size_t>(c)];
+    gc.group_begin = group_at;
+    group_at += groups_in[static_cast<size_t>(c)];
+    gc.group_end = group_at;
+    gc.batch_begin = batch_at;
+    batch_at += (manifolds_in[static_cast<size_t>(c)] + kBatchLanes - 1) / kBatchLanes;
+    gc.batch_end = batch_at;
+  }
+  g.batches.resize(static_cast<size_t>(batch_at));
+  g.groups.resize(static_cast<size_t>(group_at));
+  ctx.group_joint.assign(static_cast<size_t>(group_at), 0);
+  ctx.lane_contact.assign(static_cast<size_t>(batch_at) * kBatchLanes, -1);
+
+  // 6. Fill.
+  ContactParams cp;
+  cp.h = h;
+  cp.cfm = s.cfm / h;
+  cp.contact_erp = s.contact_erp;
+  cp.slop = s.slop;
+  cp.threshold = s.restitution_threshold;
+  cp.max_correction = s.max_correction_velocity;
+  cp.warm = s.warm_start ? s.warm_start_factor : Real(0);
+  cp.correction = s.split_impulse ? Correction::PseudoVelocity : s.position_correction;
+  cp.first_substep = first_substep;
+  ContactRowSettings crs;
+  crs.h = h;
+  crs.contact_erp = s.contact_erp;
+  crs.cfm = s.cfm;
+  crs.slop = s.slop;
+  crs.restitution_threshold = s.restitution_threshold;
+  crs.max_correction_velocity = s.max_correction_velocity;
+  crs.correction = cp.correction;
+  crs.warm_start = s.warm_start;
+  crs.warm_start_factor = s.warm_start_factor;
+  const JointRowSettings jrs{s.restitution_threshold};
+  const auto jointRows = [&](std::int32_t ji, std::vector<ConstraintRow>& rows, Correction correction) {
+    const Joint& j = w.joints_[static_cast<size_t>(ji)];
+    RowContext rc;
+    rc.h = h;
+    rc.erp = s.erp;
+    rc.cfm = s.cfm;
+    rc.joint_softness = &j.def.softness;
+    rc.owner = ji;
+    rc.rows = &rows;
+    rc.warm = s.warm_start ? &j.warm : nullptr;
+    rc.warm_factor = s.warm_start_factor;
+    rc.max_correction_velocity = s.max_correction_velocity;
+    rc.correction = correction;
+    buildJointRows(j, solverView(w, ctx, j.def.body_a), solverView(w, ctx, j.def.body_b), rc, jrs);
+  };
+  ctx.island_pushing.assign(static_cast<size_t>(ctx.island_count), 0);
+
+  std::vector<std::int32_t>&group_fill = ctx.group_fill, &lane_fill = ctx.lane_fill;
+  group_fill.resize(static_cast<size_t>(colours));
+  lane_fill.resize(static_cast<size_t>(colours));
+  for (std::int32_t c = 0; c < colours; ++c) {
+    group_fill[static_cast<size_t>(c)] = g.colours[static_cast<size_t>(c)].group_begin;
+    lane_fill[static_cast<size_t>(c)] = g.colours[static_cast<size_t>(c)].batch_begin * kBatchLanes;
+  }
+  for (size_t k = 0; k < sorted.size(); ++k) {
+    const Item& it = sorted[k];
+    const size_t c = static_cast<size_t>(ctx.colour_of[k]);
+    if (it.kind == Item::Manifold) {
+      const std::int32_t slot = lane_fill[c]++;
+      ctx.lane_contact[static_cast<size_t>(slot)] = it.index;
+      const Contact& con = w.contacts_[static_cast<size_t>(it.index)];
+      bool pushing = false;
+      fillLane(g.batches[static_cast<size_t>(slot / kBatchLanes)], slot % kBatchLanes, con, solverView(w, ctx, con.body_a),
+               solverView(w, ctx, con.body_b), it.island, cp, pushing);
+      if (pushing) ctx.island_pushing[static_cast<size_t>(it.island)] = 1;
+      continue;
+    }
+    const std::int32_t gi = group_fill[c]++;
+    RowGroup& grp = g.groups[static_cast<size_t>(gi)];
+    grp.begin = static_cast<std::int32_t>(g.rows.size());
+    grp.island = it.island;
+    if (it.kind == Item::JointGroup) {
+      ctx.group_joint[static_cast<size_t>(gi)] = it.index;
+      jointRows(it.index, g.rows, s.position_correction);
+    } else {
+      ctx.group_joint[static_cast<size_t>(gi)] = -1 - it.index;
+      Contact& con = w.contacts_[static_cast<size_t>(it.index)];
+      const BodyView a = solverView(w, ctx, con.body_a), b = solverView(w, ctx, con.body_b);
+      buildContactNormalRows(con, it.index, a, b, crs, g.rows);
+      buildContactFrictionRows(con, it.index, a, b, crs, grp.begin, g.rows);
+    }
+    grp.end = static_cast<std::int32_t>(g.rows.size());
+    for (std::int32_t r = grp.begin; r < grp.end; ++r)
+      if (g.rows[static_cast<size_t>(r)].bias_rhs > 0) ctx.island_pushing[static_cast<size_t>(it.island)] = 1;
+  }
+  for (std::int32_t c = 0; c < colours; ++c) {  // pad each colour's last batch
+    const GraphColour& gc = g.colours[static_cast<size_t>(c)];
+    for (std::int32_t slot = lane_fill[static_cast<size_t>(c)]; slot < gc.batch_end * kBatchLanes; ++slot)
+      padLane(g.batches[static_cast<size_t>(slot / kBatchLanes)], slot % kBatchLanes, ctx.static_index);
+  }
+
+  // 7. The other islands: generic rows island by island, joints first, then
+  // all contact normal rows before any friction row (ODE's and Bullet's
+  // order). The direct and exact solvers solve the ERP target with the rest
+  // in one exact solve, so joints keep it in rhs.
+  ctx.island_start.assign(static_cast<size_t>(ctx.island_count) + 1, 0);
+  bool any_other = false;
+  for (std::int32_t isl = 0; isl < ctx.island_count; ++isl) any_other = any_other || (live(isl) && !pgs(isl));
+  if (any_other) {
+    for (std::int32_t isl = 0; isl < ctx.island_count; ++isl) {
+      if (!live(isl) || pgs(isl)) continue;
+      const auto begin = static_cast<std::int32_t>(ctx.rows.size());
+      for (size_t i = 0; i < w.joints_.size(); ++i)
+        if (ctx.joint_island[i] == isl) jointRows(static_cast<std::int32_t>(i), ctx.rows, Correction::InRhs);
+      for (size_t i = 0; i < w.contacts_.size(); ++i)
+        if (ctx.contact_island[i] == isl) {
+          Contact& con = w.contacts_[i];
+          buildContactNormalRows(con, static_cast<std::int32_t>(i), solverView(w, ctx, con.body_a),
+                                 solverView(w, ctx, con.body_b), crs, ctx.rows);
+        }
+      for (size_t i = 0; i < w.contacts_.size(); ++i)
+        if (ctx.contact_island[i] == isl) {
+          Contact& con = w.contacts_[i];
+          buildContactFrictionRows(con, static_cast<std::int32_t>(i), solverView(w, ctx, con.body_a),
+                                   solverView(w, ctx, con.body_b), crs, begin, ctx.rows);
+        }
+      ctx.island_rows[static_cast<size_t>(isl)] = {begin, static_cast<std::int32_t>(ctx.rows.size())};
+      for (std::int32_t r = begin; r < static_cast<std::int32_t>(ctx.rows.size()); ++r)
+        if (ctx.rows[static_cast<size_t>(r)].bias_rhs > 0) ctx.island_pushing[static_cast<size_t>(isl)] = 1;
+    }
+  }
+
+  // Rows by kind (statistics): a manifold's valid points are a normal row
+  // each and, with friction, two tangent rows.
+  int* kinds = w.stats_.rows_by_kind;
+  for (const ConstraintRow& r : g.rows) ++kinds[static_cast<int>(r.kind)];
+  for (const ConstraintRow& r : ctx.rows) ++kinds[static_cast<int>(r.kind)];
+  for (const ContactBatch& b : g.batches)
+    for (int l = 0; l < kBatchLanes; ++l)
+      for (int i = 0; i < b.count[l]; ++i)
+        if (b.p[i].valid[l] > 0) {
+          ++kinds[static_cast<int>(RowKind::ContactNormal)];
+          if (b.mu[l] > 0) kinds[static_cast<int>(RowKind::ContactFriction)] += 2;
+        }
+  int total = 0;
+  for (int k = 0; k < kRowKindCount; ++k) total += kinds[k];
+  w.stats_.rows = total;
+}
+
+}  // namespace cairn::detail

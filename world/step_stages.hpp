@@ -1,0 +1,49 @@
+// The stages of one step, in the order world/world_step.cpp runs them,
+// each a free function over the World's state and the step's working state
+// (StepContext): what a stage reads and writes is in its signature and its
+// comment, and each is timed on its own (StepStats::stage_seconds).
+#pragma once
+
+#include "world/world_impl.hpp"
+
+namespace cairn::detail {
+
+// Springs, constant body forces and due timed impulses into the accumulators.
+void applyForces(WorldImpl& w, StepContext& ctx);
+// Broadphase, narrowphase, contact cache (warm-start impulses matched by
+// feature), the pre-solve callback (world/world_contacts.cpp).
+void collide(WorldImpl& w, StepContext& ctx);
+// Wakes what moving bodies touch, groups awake dynamic bodies into islands,
+// picks each island's solver (world/islands.cpp).
+void buildIslands(WorldImpl& w, StepContext& ctx);
+// The solver order of the bodies for this step (world/step_prepare.cpp).
+void orderSolverBodies(WorldImpl& w, StepContext& ctx);
+// v* = v + h M^-1 f, the gyroscopic term, damping (world/step_integrate.cpp).
+void integrateVelocities(WorldImpl& w, StepContext& ctx);
+// Joint rows and contact constraints of every island for this substep:
+// the coloured graph for PGS islands, generic rows for the others
+// (world/step_prepare.cpp).
+void prepareConstraints(WorldImpl& w, StepContext& ctx);
+// The velocity solve and the position-correction passes (world/step_solve.cpp).
+void solveConstraints(WorldImpl& w, StepContext& ctx);
+// x += h v, q <- exp(h w) q, with the split-impulse pseudo-velocities.
+void integratePositions(WorldImpl& w, StepContext& ctx);
+// Impulses kept for warm starting, joint feedback, joints that break.
+void storeImpulses(WorldImpl& w, StepContext& ctx);
+// Restitution, once per step after the last substep (world/step_solve.cpp).
+void applyRestitution(WorldImpl& w, StepContext& ctx);
+// Contact begin/end events (world/world_contacts.cpp).
+void emitContactEvents(WorldImpl& w, StepContext& ctx);
+// Sleeping bookkeeping (world/islands.cpp).
+void updateSleep(WorldImpl& w, StepContext& ctx);
+
+// The non-finite guard (world/step_guard.cpp).
+void saveStepStart(WorldImpl& w, StepContext& ctx);
+void saveStepEnd(WorldImpl& w, StepContext& ctx);
+void guardBodies(WorldImpl& w, StepContext& ctx, const char* stage);
+// After the solve: islands whose velocities went non-finite are stopped;
+// the stage named is "row building" when their rows held the non-finite
+// value, else "constraint solve".
+void guardSolve(WorldImpl& w, StepContext& ctx);
+
+}  // namespace cairn::detail

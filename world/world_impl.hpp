@@ -1,0 +1,279 @@
+// The World behind the public face (include/cairn/world.hpp): the
+// persistent state (bodies, shapes, joints, springs, the broadphase, the
+// contact cache, settings, events) and the per-step working state
+// (StepContext) that the stages of world/world_step.cpp hand to each other.
+//
+// Storage: bodies, shapes, joints and springs live in slot arrays addressed
+// by the handles' indices; a destroyed object leaves a free slot (alive =
+// false) that the next creation reuses with the next generation, so handles
+// stay small integers and old ones are recognised as stale. Loops over a
+// slot array skip dead slots.
+//
+// Internal: cairn's own tools (validation/, the command line, tests and
+// benchmarks) reach this through WorldAccess (world/world_access.hpp);
+// nothing here is installed.
+#pragma once
+
+#include "cairn/world.hpp"
+#include "collision/broadphase.hpp"
+#include "collision/manifold.hpp"
+#include "constraints/contact.hpp"
+#include "constraints/joint.hpp"
+#include "constraints/row.hpp"
+#include "dynamics/body.hpp"
+#include "solver/direct_solver.hpp"
+#include "solver/graph_solver.hpp"
+#include "solver/pgs.hpp"
+#include "solver/solver_body.hpp"
+#include "solver/worker_pool.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cairn {
+
+struct Spring {
+  SpringDef def;
+  Vec3 local_a, local_b;  // anchors in the body frames (world points for the world)
+  Real rest_length = 0;
+  bool alive = true;
+  std::uint32_t generation = 0;
+};
+
+// A shape in the World: which body and which of its shapes, and its
+// broadphase proxy.
+struct ShapeRef {
+  BodyId body;
+  std::int32_t index = 0;  // into the body's shapes
+  std::int32_t proxy = -1;
+  bool alive = true;
+  std::uint32_t generation = 0;
+};
+
+namespace detail {
+
+// A constraint of the PGS graph before it is laid out (world/step_prepare.cpp).
+struct GraphItem {
+  enum Kind : std::uint8_t { JointGroup, ContactGroup, Manifold } kind;
+  std::int32_t index;  // joint or contact
+  std::int32_t a, b;   // solver body indices
+  std::int32_t island;
+};
+
+// What one step's stages hand each other (docs/architecture.md). Sized
+// once and reused: after the first steps of a scene nothing here allocates.
+struct StepContext {
+  Real h = 0;   // the step
+  Real hs = 0;  // the substep
+  int substep = 0;
+
+  // Islands (world/islands.cpp): per body slot the island of an awake
+  // dynamic body, -1 otherwise.
+  std::vector<std::int32_t> body_island;
+  std::vector<std::int32_t> uf_parent;
+  int island_count = 0;
+  std::vector<SolverMethod> island_method;  // how each island is solved this step
+
+  // Solver order (world/step_prepare.cpp): index 0 for the world and every
+  // static body, then the awake dynamic bodies island by island (1 to
+  // dynamic_count), then the kinematic bodies.
+  std::vector<std::int32_t> solver_of_body;  // per body slot
+  std::vector<std::int32_t> body_of_solver;  // per solver index (-1 for 0)
+  std::vector<std::int32_t> island_first_body;  // per island: its first solver index; then dynamic_count
+  int dynamic_count = 0;
+  int solver_count = 1;  // solver bodies in all
+  static constexpr int static_index = 0;
+  std::vector<SolverBody> velocities;  // v, w per solver body
+  std::vector<SolverBody> pseudo;      // split-impulse pseudo-velocities
+  bool has_pseudo = false;
+  std::vector<Vec3> orientation_offset;  // per body slot (implicit-midpoint gyroscopic term)
+
+  // Constraints by island: per contact (in contacts_) and per joint.
+  std::vector<std::int32_t> contact_island;
+  std::vector<std::int32_t> joint_island;
+
+  // The PGS islands' constraint graph and where its lanes and groups came from.
+  GraphProblem graph;
+  std::vector<std::int32_t> lane_contact;  // per batch lane (batch * 8 + lane): contact index, -1 padding
+  std::vector<std::int32_t> group_joint;   // per row group: joint index, or -1 - contact index
+  std::vector<char> island_pushing;        // per island: some contact deeper than the slop (being pushed out)
+  // Scratch of the colouring.
+  std::vector<GraphItem> items, sorted_items;
+  std::vector<std::int32_t> colour_of, adj_start, adj, level, queue, level_start, last_colour;
+  std::vector<std::int32_t> groups_in, manifolds_in, group_fill, lane_fill;
+
+  // The other islands (direct, exact LCP): generic rows, island by island.
+  std::vector<ConstraintRow> rows;
+  std::vector<std::pair<std::int32_t, std::int32_t>> island_rows;  // row range per island (empty for PGS islands)
+  std::vector<Real> correction_lambda;  // their correction passes' impulses
+
+  // The non-finite guard (world/step_guard.cpp).
+  struct SavedState {
+    Vec3 x;
+    Quat q;
+    Vec3 v;
+    Vec3 w;
+  };
+  std::vector<SavedState> step_start;  // per body slot: the last good state
+  std::vector<char> frozen_island;
+  bool any_frozen = false;
+
+  // Scratch.
+  std::vector<std::int32_t> island_start, island_fill, island_root, wake_list, sleep_first;
+  std::vector<Real> island_min;
+};
+
+class WorldImpl {
+ public:
+  WorldImpl() = default;
+  explicit WorldImpl(const Vec3& gravity) : gravity_(gravity) {}
+
+  // --- Creation and destruction (world/world_bodies.cpp, world_joints.cpp)
+  BodyId createBody(const BodyDef& def);
+  void destroyBody(BodyId id);
+  ShapeId addShape(BodyId id, const ShapeDesc& shape);
+  void removeShape(ShapeId id);
+  void setType(BodyId id, BodyType type);
+  JointId createJoint(const JointDef& def);
+  void destroyJoint(JointId id);
+  SpringId createSpring(const SpringDef& def);
+  void destroySpring(SpringId id);
+
+  // Handle checks: throw HandleError for a stale or foreign handle.
+  void check(BodyId id) const;
+  void check(JointId id) const;
+  void check(SpringId id) const;
+  void check(ShapeId id) const;
+  bool valid(BodyId id) const;
+  bool valid(JointId id) const;
+  bool valid(SpringId id) const;
+  bool valid(ShapeId id) const;
+
+  // --- Access for cairn's own tools (no generation check: indices).
+  int bodySlots() const { return static_cast<int>(bodies_.size()); }
+  int aliveBodies() const { return alive_bodies_; }
+  const Body& body(BodyId id) const { return bodies_[static_cast<size_t>(id.index)]; }
+  Body& body(BodyId id) { return bodies_[static_cast<size_t>(id.index)]; }
+  const Body& body(int index) const { return bodies_[static_cast<size_t>(index)]; }
+  Body& body(int index) { return bodies_[static_cast<size_t>(index)]; }
+  const std::vector<Body>& bodies() const { return bodies_; }
+  BodyId bodyId(int index) const { return BodyId{index, bodies_[static_cast<size_t>(index)].generation}; }
+  BodyId findBody(const std::string& name) const;
+  const std::vector<Spring>& springs() const { return springs_; }
+  int jointSlots() const { return static_cast<int>(joints_.size()); }
+  const Joint& joint(JointId id) const { return joints_[static_cast<size_t>(id.index)]; }
+  Joint& joint(JointId id) { return joints_[static_cast<size_t>(id.index)]; }
+  JointId jointId(int index) const { return JointId{index, joints_[static_cast<size_t>(index)].generation}; }
+  JointId findJoint(const std::string& name) const;
+  JointError jointError(JointId id) const;
+  const JointFeedback& jointFeedback(JointId id) const { return joint(id).feedback; }
+  void removeJoint(JointId id);  // breaks it: stops acting, handle valid
+  // The generic rows of the last (sub)step's direct and exact islands.
+  const std::vector<ConstraintRow>& rows() const { return ctx_.rows; }
+  // Every row of the last (sub)step, the PGS islands' contacts expanded
+  // to generic rows (for inspection and the exact solvers; allocates).
+  std::vector<ConstraintRow> expandedRows() const;
+  const std::vector<Contact>& contacts() const { return contacts_; }
+  const std::vector<ShapeRef>& shapes() const { return shapes_; }
+  const BroadPhase& broadPhase() const { return broadphase_; }
+  BroadPhase& broadPhase() { return broadphase_; }
+  Real maxPenetration() const;
+  BodyView view(BodyId id) const;
+  BodyView view(int index) const;
+  const StepContext& stepContext() const { return ctx_; }
+
+  // --- Forces
+  void applyForce(BodyId id, const Vec3& force, const Vec3& world_point);
+  void applyCentralForce(BodyId id, const Vec3& force);
+  void applyTorque(BodyId id, const Vec3& torque);
+  void applyImpulse(BodyId id, const Vec3& impulse, const Vec3& world_point);
+  void setKinematicVelocity(BodyId id, const Vec3& linear, const Vec3& angular);
+
+  // --- Contacts
+  const std::vector<ContactEvent>& contactEvents() const { return contact_events_; }
+  void setContactCallback(ContactCallback cb) { contact_callback_ = std::move(cb); }
+  void setCollisionFilterCallback(World::CollisionFilter f) { filter_callback_ = std::move(f); }
+  void setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution);
+  bool shouldCollide(const Body& a, const Body& b, BodyId ia, BodyId ib) const;
+
+  // --- Sleeping
+  void wakeBody(BodyId id);
+  void wakeIsland(std::int32_t island);
+  void putIslandToSleep(BodyId id);
+  bool isAsleep(BodyId id) const { return body(id).asleep; }
+
+  // --- Settings
+  const Vec3& gravity() const { return gravity_; }
+  void setGravity(const Vec3& g);
+  SolverSettings& settings() { return settings_; }
+  const SolverSettings& settings() const { return settings_; }
+  void setSettings(const SolverSettings& s);
+
+  // --- Stepping (world/world_step.cpp)
+  void step(Real h);
+  int stepCount() const { return step_count_; }
+  Real time() const { return time_; }
+  const StepStats& lastStepStats() const { return stats_; }
+  const std::vector<NumericalEvent>& numericalEvents() const { return numerical_events_; }
+  const std::vector<Diagnostic>& diagnostics() const { return diagnostics_; }
+  const std::vector<JointBreakEvent>& jointBreakEvents() const { return break_events_; }
+
+  Real kineticEnergy() const;
+  Real potentialEnergy() const;
+  Vec3 linearMomentum() const;
+
+  // ----------------------------------------------------------------------
+  // The state itself. The step's stages (world/*.cpp) work on these.
+  Vec3 gravity_ = Vec3(0, Real(-9.81), 0);
+  SolverSettings settings_;
+  std::vector<Body> bodies_;
+  std::vector<std::int32_t> free_bodies_;
+  int alive_bodies_ = 0;
+  std::vector<Spring> springs_;
+  std::vector<std::int32_t> free_springs_;
+  std::vector<Joint> joints_;
+  std::vector<std::int32_t> free_joints_;
+  std::vector<ShapeRef> shapes_;
+  std::vector<std::int32_t> free_shapes_;
+  BroadPhase broadphase_;
+  std::vector<Contact> contacts_;      // sorted by key
+  std::vector<Contact> old_contacts_;  // scratch: last step's, for matching
+  std::vector<Contact> ended_contacts_;  // touching contacts removed with a body or shape between steps
+  std::vector<std::pair<int, int>> pairs_;
+  std::vector<Manifold> manifolds_;
+  std::vector<ContactEvent> contact_events_;
+  ContactCallback contact_callback_;
+  World::CollisionFilter filter_callback_;
+  struct PairMaterial {
+    std::uint64_t key;
+    Real friction, restitution;
+  };
+  std::vector<PairMaterial> pair_materials_;  // sorted by key
+  std::vector<std::int32_t> sleep_island_;   // per body slot: the island it fell asleep with
+
+  StepContext ctx_;
+  DirectSolver direct_solver_;  // keeps CHOLMOD's symbolic analysis while the structure holds
+  std::unique_ptr<WorkerPool> pool_;
+  std::uint64_t rng_state_ = 0;
+  bool rng_seeded_ = false;
+
+  int step_count_ = 0;
+  Real time_ = 0;
+  StepStats stats_;
+  std::vector<NumericalEvent> numerical_events_;
+  std::vector<Diagnostic> diagnostics_;
+  std::vector<JointBreakEvent> break_events_;
+
+  void diagnose(size_t body, const char* kind, const std::string& detail);
+  void registerShape(BodyId id, std::int32_t index_in_body);
+  void recomputeMass(Body& b, const std::string& object);
+  void dropContactsOf(BodyId body, std::int32_t shape);  // shape -1: every shape of the body
+  int createSpringIndex(const SpringDef& def, const std::string& object);
+};
+
+}  // namespace detail
+
+void validateSettings(const SolverSettings& s);
+
+}  // namespace cairn

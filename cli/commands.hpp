@@ -12,5 +12,6 @@ void addSoftnessCommand(CLI::App& app, int& status);
 void addScenesCommand(CLI::App& app, int& status);
 void addValidateCommand(CLI::App& app, int& status);
 void addSweepCommand(CLI::App& app, int& status);
+void addViewCommand(CLI::App& app, int& status);
 
 }  // namespace cairn::cli

@@ -1,0 +1,119 @@
+// Everything the viewer knows about a running World is read here, through
+// the World's public accessors only: bodies(), isAsleep(), contacts(),
+// joint(), jointError(), jointFeedback(), settings(), gravity(), time().
+//
+// Islands are derived as world/islands.cpp builds them: dynamic bodies
+// linked by enabled contacts or unbroken joints, static and kinematic
+// bodies never linking (a floor under two stacks keeps them apart). Each
+// island is named by its lowest body index, so colours stay put from frame
+// to frame while the island does.
+#include "validation/replay_record.hpp"
+
+#include <numeric>
+
+namespace cairn::validation {
+
+namespace {
+
+void put(std::vector<float>& out, const Vec3& v) {
+  out.insert(out.end(), {float(v.x()), float(v.y()), float(v.z())});
+}
+
+std::int32_t root(std::vector<std::int32_t>& parent, std::int32_t i) {
+  while (parent[size_t(i)] != i) i = parent[size_t(i)] = parent[size_t(parent[size_t(i)])];
+  return i;
+}
+
+// A point given in a body's frame (from its center of mass), in the world;
+// the world's own points are already world points.
+Vec3 worldPoint(const World& w, BodyId id, const Vec3& local) {
+  return id.isWorld() ? local : w.body(id).transform().apply(local);
+}
+
+Vec3 worldAxis(const World& w, BodyId id, const Vec3& local) {
+  return id.isWorld() ? local : Vec3(w.body(id).orientation * local);
+}
+
+}  // namespace
+
+Replay describeWorld(const World& world, Real dt) {
+  Replay r;
+  r.dt = dt;
+  r.substeps = world.settings().substeps;
+  r.gravity = world.gravity();
+  for (const Body& b : world.bodies())
+    r.bodies.push_back(ReplayBody{b.name, b.type, b.isDynamic() ? double(b.mass) : 0.0, b.shapes, b.position, b.orientation});
+  for (int j = 0; j < world.jointCount(); ++j) {
+    const JointDef& d = world.joint(JointId{j}).def;
+    r.joints.push_back(ReplayJoint{d.name, d.type, d.body_a.index, d.body_b.index});
+  }
+  return r;
+}
+
+ReplayRecorder::ReplayRecorder(const World& world, Real dt, Replay& out) : out_(out) {
+  out_ = describeWorld(world, dt);
+  out_.overlays.recorded = true;
+  out_.overlays.manifold_begin.push_back(0);
+  out_.overlays.point_begin.push_back(0);
+  record(world);
+}
+
+void ReplayRecorder::record(const World& world) {
+  ReplayTrack& t = out_.cairn;
+  ReplayOverlays& o = out_.overlays;
+  const auto& bodies = world.bodies();
+  t.time.push_back(world.time());
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const Body& b = bodies[i];
+    put(t.position, b.position);
+    t.orientation.insert(t.orientation.end(), {float(b.orientation.x()), float(b.orientation.y()),
+                                               float(b.orientation.z()), float(b.orientation.w())});
+    put(t.velocity, b.linear_velocity);
+    put(t.angular_velocity, b.angular_velocity);
+    o.asleep.push_back(world.isAsleep(BodyId{std::int32_t(i)}) ? 1 : 0);
+  }
+
+  parent_.resize(bodies.size());
+  std::iota(parent_.begin(), parent_.end(), 0);
+  const auto link = [&](BodyId a, BodyId b) {
+    if (a.isWorld() || b.isWorld() || !world.body(a).isDynamic() || !world.body(b).isDynamic()) return;
+    const std::int32_t ra = root(parent_, a.index), rb = root(parent_, b.index);
+    parent_[size_t(std::max(ra, rb))] = std::min(ra, rb);
+  };
+  for (const Contact& c : world.contacts()) {
+    if (!c.enabled) continue;
+    link(c.body_a, c.body_b);
+    if (!c.touching || c.count == 0) continue;
+    Vec3 friction = Vec3::Zero();
+    for (int p = 0; p < c.count; ++p) {
+      const ContactPointState& s = c.points[p];
+      put(o.point_position, (worldPoint(world, c.body_a, s.local_a) + worldPoint(world, c.body_b, s.local_b)) / 2);
+      o.point_impulse.push_back(float(s.normal_impulse));
+      friction += s.friction_impulse;
+    }
+    put(o.manifold_normal, c.normal);
+    put(o.manifold_friction, friction);
+    o.manifold_body.insert(o.manifold_body.end(), {c.body_a.index, c.body_b.index});
+    o.manifold_points.push_back(std::uint8_t(c.count));
+  }
+  o.contact_frame.push_back(std::uint32_t(o.contact_frame.size()));
+  o.manifold_begin.push_back(std::uint32_t(o.manifold_points.size()));
+  o.point_begin.push_back(std::uint32_t(o.point_impulse.size()));
+
+  for (int j = 0; j < world.jointCount(); ++j) {
+    const Joint& jt = world.joint(JointId{j});
+    if (!jt.broken) link(jt.def.body_a, jt.def.body_b);
+    put(o.joint_anchor_a, worldPoint(world, jt.def.body_a, jt.local_anchor_a));
+    put(o.joint_anchor_b, worldPoint(world, jt.def.body_b, jt.local_anchor_b));
+    put(o.joint_axis, worldAxis(world, jt.def.body_a, jt.local_axis_a));
+    const JointError e = world.jointError(JointId{j});
+    o.joint_error.insert(o.joint_error.end(), {float(e.linear), float(e.angular)});
+    const JointFeedback& f = world.jointFeedback(JointId{j});
+    put(o.joint_force_a, f.force_a);
+    put(o.joint_force_b, f.force_b);
+  }
+  for (size_t i = 0; i < bodies.size(); ++i)
+    o.island.push_back(bodies[i].isDynamic() ? root(parent_, std::int32_t(i)) : -1);
+}
+
+}  // namespace cairn::validation

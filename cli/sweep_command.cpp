@@ -6,7 +6,9 @@
 // combination of the --vary lists, and Bullet once per distinct setting it
 // can see, and writes DIR/sweep.csv, sweep.md, sweep.json and pareto.png:
 // wall time per step against the accuracy figures, with the
-// Pareto-optimal settings marked (validation/sweep_*.hpp, docs/tradeoff.md).
+// Pareto-optimal settings marked (validation/sweep_*.hpp, docs/tradeoff.md),
+// and DIR/replay.html: the scene with its own settings in cairn and Bullet,
+// in 3D (docs/viewer.md; written by shard 0, copied by --merge).
 // --shard i/n (0-based) runs every n-th job from the i-th; --merge joins
 // the parts' directories into one sweep.
 //
@@ -17,6 +19,7 @@
 #include "cli/scene_arg.hpp"
 #include "cairn/error.hpp"
 #include "validation/plot_script.hpp"
+#include "validation/replay_page.hpp"
 #include "validation/report.hpp"
 #include "validation/scene_writer.hpp"
 #include "validation/sweep_table.hpp"
@@ -91,6 +94,15 @@ int merge(const SweepOptions& o) {
     return 2;
   }
   try {
+    whole.manifest.erase("replay");
+    for (const std::string& d : o.merge) {
+      std::error_code ec;
+      if (!fs::exists(fs::path(d) / "replay.html", ec)) continue;
+      fs::copy_file(fs::path(d) / "replay.html", fs::path(o.out) / "replay.html", fs::copy_options::overwrite_existing, ec);
+      if (ec) throw InputError((fs::path(o.out) / "replay.html").string(), "", "cannot copy the replay page: " + ec.message());
+      whole.manifest["replay"] = "replay.html";
+      break;
+    }
     writeSweepFiles(o.out, whole);
   } catch (const InputError& e) {
     std::cerr << "cairn sweep: " << e.what() << "\n";
@@ -180,6 +192,12 @@ int sweep(const SweepOptions& o) {
   }
   markPareto(table.rows, axis);
   try {
+    if (shard.owns(0)) {  // the scene as given, cairn and Bullet, for the viewer
+      std::cout << "recording the replay (the scene's own settings, cairn and Bullet)...\n" << std::flush;
+      const SceneResult r = validateScene(in.scene, in.name, in.source, in.description, true);
+      writeReplayPage((fs::path(o.out) / "replay.html").string(), *r.replay);
+      m["replay"] = "replay.html";
+    }
     writeSweepFiles(o.out, table);
   } catch (const InputError& e) {
     std::cerr << "cairn sweep: " << e.what() << "\n";

@@ -6,7 +6,8 @@
 // SCENE is a scene file or a standard scenario key (`cairn scenes --list`).
 // Prints a summary table (scene, key figures cairn / Bullet, ms/step,
 // pass or fail) and one line per figure outside its tolerance; with
-// --report, writes DIR/report.md, a CSV per scene and PNG plots.
+// --report, writes DIR/report.md, a CSV per scene, PNG plots and a replay
+// page per scene (DIR/SCENE.replay.html: cairn and Bullet in 3D).
 //
 // Exit status: 0 every scene within its tolerances; 1 some figure outside
 // them; 2 bad input (a missing scene file, a bad scene or validation block,
@@ -81,7 +82,7 @@ int validate(const ValidateOptions& opt) {
               << " joints, " << in.scene.steps << " steps, cairn and Bullet...\n"
               << std::flush;
     try {
-      results.push_back(validation::validateScene(in.scene, in.name, in.source, in.description));
+      results.push_back(validation::validateScene(in.scene, in.name, in.source, in.description, !opt.report.empty()));
     } catch (const InputError& e) {
       std::cerr << "cairn validate: " << in.source << ": " << e.what() << "\n";
       return 2;
@@ -107,6 +108,7 @@ int validate(const ValidateOptions& opt) {
       return 2;
     }
     std::cout << "report: " << (fs::path(opt.report) / "report.md").string() << "\n";
+    std::cout << "replays (open in a browser): " << (fs::path(opt.report) / "*.replay.html").string() << "\n";
   }
   return all_pass ? 0 : 1;
 }

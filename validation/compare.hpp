@@ -26,6 +26,7 @@
 #pragma once
 
 #include "cairn/scene.hpp"
+#include "validation/replay.hpp"
 #include "world/world_access.hpp"
 
 #include <nlohmann/json.hpp>
@@ -176,13 +177,17 @@ struct SceneResult {
   EngineRun reference;  // cairn, method "direct", when spec.direct_reference
   std::vector<Figure> figures;
   std::vector<std::string> skipped;  // what Bullet lacks (BulletOracle::skipped)
+  // cairn's run recorded for the viewer with Bullet's beside it, when asked
+  // for (validateScene's record_replay).
+  std::shared_ptr<Replay> replay;
   bool pass() const;
   std::vector<const Figure*> failures() const;
 };
 
 // Runs `scene` in cairn and in Bullet (OracleOptions{match_cairn = true})
-// for scene.steps steps and fills cairn, bullet and skipped.
-void runEngines(SceneResult& result);
+// for scene.steps steps and fills cairn, bullet and skipped; with
+// record_replay also result.replay (replay_bullet.hpp).
+void runEngines(SceneResult& result, bool record_replay = false);
 
 // Records samples from a cairn World: the real one, or the shadow one that
 // holds Bullet's states. One Recorder per engine (it keeps the first
@@ -207,9 +212,12 @@ class Recorder {
 // The constructor records sample 0; step(s) advances by scene.dt, records
 // sample s and returns false once the run has stopped (the reason is in
 // the EngineRun's failure). `scene` and `spec` must outlive the runner.
+// With `replay`, every sample is also recorded there for the viewer.
+class ReplayRecorder;
 class CairnRunner {
  public:
-  CairnRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out);
+  CairnRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out, Replay* replay = nullptr);
+  ~CairnRunner();
   bool step(int s);
   bool running() const { return running_; }
   const World& world() const { return world_; }
@@ -219,6 +227,7 @@ class CairnRunner {
   World world_;
   Recorder recorder_;
   EngineRun& out_;
+  std::unique_ptr<ReplayRecorder> replay_;
   bool running_ = true;
 };
 
@@ -269,6 +278,6 @@ double measurePeriod(const std::vector<double>& t, const std::vector<double>& x)
 
 // Everything for one scene: run both engines and compare.
 SceneResult validateScene(const SceneDesc& scene, const std::string& name, const std::string& source,
-                          const std::string& description);
+                          const std::string& description, bool record_replay = false);
 
 }  // namespace cairn::validation

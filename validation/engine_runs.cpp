@@ -5,6 +5,8 @@
 #include "cairn/error.hpp"
 #include "validation/bullet_oracle.hpp"
 #include "validation/compare.hpp"
+#include "validation/replay_bullet.hpp"
+#include "validation/replay_record.hpp"
 #include "world/world_access.hpp"
 
 #include <algorithm>
@@ -213,10 +215,13 @@ bool copyStates(const BulletOracle& oracle, World& shadow) {
 
 }  // namespace
 
-CairnRunner::CairnRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out)
+CairnRunner::CairnRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out, Replay* replay)
     : dt_(scene.dt), world_(buildWorld(scene)), recorder_(scene, spec), out_(out) {
   recorder_.record(world_, 0, 0, out_);
+  if (replay) replay_ = std::make_unique<ReplayRecorder>(world_, dt_, *replay);
 }
+
+CairnRunner::~CairnRunner() = default;
 
 bool CairnRunner::step(int s) {
   if (!running_) return false;
@@ -231,6 +236,7 @@ bool CairnRunner::step(int s) {
     return false;
   }
   recorder_.record(world_, s * dt_, sec, out_);
+  if (replay_) replay_->record(world_);
   return true;
 }
 
@@ -258,15 +264,22 @@ bool BulletRunner::step(int s) {
 
 const std::vector<std::string>& BulletRunner::skipped() const { return oracle_->skipped(); }
 
-void runEngines(SceneResult& r) {
+void runEngines(SceneResult& r, bool record_replay) {
+  if (record_replay) r.replay = std::make_shared<Replay>();
   // One step each in turn, so both runs see the machine in the same state.
-  CairnRunner cairn(r.scene, r.spec, r.cairn);
+  CairnRunner cairn(r.scene, r.spec, r.cairn, r.replay.get());
   BulletRunner bullet(r.scene, r.spec, r.bullet);
   for (int s = 1; s <= r.scene.steps && (cairn.running() || bullet.running()); ++s) {
     cairn.step(s);
     bullet.step(s);
   }
   r.skipped = bullet.skipped();
+  if (r.replay) {
+    r.replay->title = r.name + ": cairn and Bullet";
+    r.replay->source = r.source;
+    addBulletRun(*r.replay, r.bullet, r.spec);
+    fitContacts(*r.replay);
+  }
   if (r.spec.direct_reference) {  // the exact bilateral solve of the same scene, after the timed runs
     SceneDesc exact = r.scene;
     exact.solver.method = SolverMethod::Direct;
@@ -277,14 +290,14 @@ void runEngines(SceneResult& r) {
 }
 
 SceneResult validateScene(const SceneDesc& scene, const std::string& name, const std::string& source,
-                          const std::string& description) {
+                          const std::string& description, bool record_replay) {
   SceneResult r;
   r.name = name;
   r.source = source;
   r.description = description;
   r.scene = scene;
   r.spec = validationSpec(scene);
-  runEngines(r);
+  runEngines(r, record_replay);
   r.figures = compareRuns(r.scene, r.spec, r.cairn, r.bullet, r.spec.direct_reference ? &r.reference : nullptr);
   return r;
 }

@@ -2,6 +2,7 @@
 
 #include "cairn/error.hpp"
 #include "validation/plot_script.hpp"
+#include "validation/replay_page.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -260,9 +261,16 @@ std::string sceneCsv(const SceneResult& r, const std::string& stem, Json& plots,
   return out;
 }
 
-std::string sceneSection(const SceneResult& r, const std::vector<std::string>& pngs) {
+std::string sceneSection(const SceneResult& r, const std::vector<std::string>& pngs, const std::string& replay_page) {
   std::ostringstream md;
   md << "## " << r.name << " — " << (r.pass() ? "pass" : "FAIL") << "\n\n";
+  if (!replay_page.empty()) {
+    md << "Replay in 3D: [" << replay_page << "](" << replay_page << ") (cairn solid, Bullet as orange wireframes";
+    if (r.replay->parting && r.replay->parting->frame >= 0)
+      md << "; they part by more than " << num(r.replay->parting->tolerance) << " m at t = "
+         << fmt("%.3f", r.replay->parting->time) << " s, marked red on the time slider";
+    md << "; docs/viewer.md).\n\n";
+  }
   md << "Source: " << r.source << ". " << kindName(r.spec.kind) << " comparison";
   if (!r.spec.scenario.empty()) md << " (scenario type " << r.spec.scenario << ")";
   md << "; " << r.scene.steps << " steps of " << num(r.scene.dt) << " s, " << r.scene.bodies.size() << " bodies, "
@@ -312,7 +320,12 @@ std::string writeReport(const std::string& dir, const std::vector<SceneResult>& 
     const std::string stem = reportStem(r.name, taken);
     std::vector<std::string> pngs;
     writeFile(root / (stem + ".csv"), sceneCsv(r, stem, plots, pngs));
-    sections += sceneSection(r, pngs);
+    std::string page;
+    if (r.replay) {
+      page = stem + ".replay.html";
+      writeReplayPage((root / page).string(), *r.replay);
+    }
+    sections += sceneSection(r, pngs, page);
   }
   md << sections;
   writeFile(root / "report.md", md.str());

@@ -10,6 +10,8 @@
 //   N_joint_error.png    largest joint error over time
 //   N_energy.png         kinetic + potential energy over time
 //   N_penetration.png    deepest penetration over time
+//   N.replay.html        the run in 3D, cairn and Bullet (docs/viewer.md),
+//                        when the result carries a replay
 #pragma once
 
 #include "validation/compare.hpp"

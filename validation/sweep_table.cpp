@@ -104,6 +104,7 @@ Json sweepIdentity(const Json& manifest) {
   Json id = manifest;
   id.erase("shard");
   id.erase("command");
+  id.erase("replay");  // only shard 0 writes the replay page
   return id;
 }
 
@@ -158,6 +159,9 @@ std::string sweepMarkdown(const SweepTable& t) {
   if (!m.value("analytic", std::string()).empty())
     md << "`analytic_error` is the " << m["analytic"].get<std::string>() << " error against the closed form. ";
   md << "Columns and their meaning: docs/tradeoff.md.\n\n";
+  if (m.contains("replay"))
+    md << "Replay in 3D of the scene with its own settings, cairn solid and Bullet as orange wireframes: ["
+       << m["replay"].get<std::string>() << "](" << m["replay"].get<std::string>() << ") (docs/viewer.md).\n\n";
 
   // Measure columns any row has.
   std::vector<int> shown;

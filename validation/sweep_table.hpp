@@ -21,7 +21,8 @@ namespace cairn::validation {
 struct SweepTable {
   // format, scene, source, scene_hash, kind, steps, dt, vary, columns,
   // jobs, cairn_jobs, pareto_axis, analytic, exact_every; plus shard
-  // ("i/n") for a part and command (how it was made).
+  // ("i/n") for a part, command (how it was made) and replay (the replay
+  // page's file name, written by the whole sweep or shard 0).
   nlohmann::ordered_json manifest;
   std::vector<std::string> setting_columns;
   std::vector<SweepRow> rows;  // by index

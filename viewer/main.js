@@ -15,9 +15,9 @@ var CairnViewer = CairnViewer || {};
   function hue(i, s, l) { return colour.setHSL((i * 0.618034) % 1, s, l); }
 
   // Average body size and weight (for overlay lengths) and the center and
-  // radius of where the moving bodies go (for the camera and the planes),
-  // from the first, middle and last frames; static bodies count only in a
-  // scene without moving ones (a ground box would dwarf the stack on it).
+  // radius of the moving bodies at the start (for the camera and the
+  // planes); static bodies count only in a scene without moving ones (a
+  // ground box would dwarf the stack on it).
   function measure(replay) {
     const box = new THREE.Box3(), p = new THREE.Vector3();
     const moving = replay.bodies.some((b) => b.type !== 'static');
@@ -29,11 +29,9 @@ var CairnViewer = CairnViewer || {};
       if (body.type !== 'static') { size += s; sized++; }
       if (body.type === 'dynamic') { weight += body.mass * Math.hypot(...replay.gravity); heavy++; }
       if (moving && body.type === 'static') return;
-      for (const f of [0, replay.frames >> 1, replay.frames - 1]) {
-        p.fromArray(replay.cairn.position, 3 * (f * replay.bodyCount + b));
-        box.expandByPoint(p.clone().addScalar(-s / 2));
-        box.expandByPoint(p.clone().addScalar(s / 2));
-      }
+      p.fromArray(replay.cairn.position, 3 * b);
+      box.expandByPoint(p.clone().addScalar(-s / 2));
+      box.expandByPoint(p.clone().addScalar(s / 2));
     });
     if (box.isEmpty()) box.set(new THREE.Vector3(-1, -1, -1), new THREE.Vector3(1, 1, 1));
     const sphere = box.getBoundingSphere(new THREE.Sphere());
@@ -58,7 +56,7 @@ var CairnViewer = CairnViewer || {};
     this.scene.add(sun);
 
     this.camera = new THREE.PerspectiveCamera(45, 1, m.radius / 100, m.radius * 100);
-    const dir = new THREE.Vector3(0.8, 0.5, 1.0).normalize();
+    const dir = new THREE.Vector3(0.45, 0.4, 1.0).normalize();
     this.camera.position.copy(m.center).addScaledVector(dir, 2.6 * m.radius);
     this.controls = new THREE.OrbitControls(this.camera, this.renderer.domElement);
     this.controls.target.copy(m.center);
@@ -80,7 +78,7 @@ var CairnViewer = CairnViewer || {};
     this.follow = document.getElementById('follow');
     this.followFrom = null;
     this.shownFrame = -1;
-    this.frameTimes = null;
+    this.frameTimes = this.scriptTimes = null;
 
     this.setupHud();
     window.addEventListener('resize', () => this.resize());
@@ -195,10 +193,12 @@ var CairnViewer = CairnViewer || {};
   Viewer.prototype.start = function () {
     let last = performance.now();
     const loop = (now) => {
+      const begin = performance.now();  // `now` is the frame's start, earlier when the thread is busy
       const seconds = Math.min(0.1, (now - last) / 1000);
       if (this.frameTimes) this.frameTimes.push(now - last);
       last = now;
       this.draw(this.timeline.advance(seconds));
+      if (this.scriptTimes) this.scriptTimes.push(performance.now() - begin);
       requestAnimationFrame(loop);
     };
     this.draw(this.timeline.advance(0));
@@ -211,6 +211,7 @@ var CairnViewer = CairnViewer || {};
     const bodyIndex = (name) => r.bodies.findIndex((b) => b.name === name);
     return {
       ready: true,
+      viewer,  // the objects themselves, for the console
       loadMilliseconds: performance.now(),
       shapeCount: r.shapeCount,
       frames: r.frames,
@@ -234,16 +235,20 @@ var CairnViewer = CairnViewer || {};
       pickedName: () => (viewer.picking.body >= 0 ? r.bodies[viewer.picking.body].name : null),
       infoText: () => document.getElementById('info').textContent,
       parting: () => r.parting,
-      // Plays for `ms` and reports the intervals between animation frames.
+      // Plays for `ms` and reports the intervals between animation frames
+      // and the time the page's script spends in each (advancing, updating
+      // the instances and overlays, issuing the draw; the rendering itself
+      // runs in the GPU process).
       measureFrames: (ms) => new Promise((resolve) => {
         viewer.frameTimes = [];
+        viewer.scriptTimes = [];
         t.setPlaying(true);
         setTimeout(() => {
-          const d = viewer.frameTimes.slice(1).sort((a, b) => a - b);
-          viewer.frameTimes = null;
-          const mean = d.reduce((s, x) => s + x, 0) / Math.max(1, d.length);
+          const d = viewer.frameTimes.slice(1).sort((a, b) => a - b), s = viewer.scriptTimes;
+          viewer.frameTimes = viewer.scriptTimes = null;
+          const mean = d.reduce((a, x) => a + x, 0) / Math.max(1, d.length);
           resolve({ frames: d.length, meanMs: mean, p95Ms: d[Math.floor(0.95 * (d.length - 1))] || 0,
-                    fps: mean > 0 ? 1000 / mean : 0 });
+                    fps: mean > 0 ? 1000 / mean : 0, scriptMs: s.reduce((a, x) => a + x, 0) / Math.max(1, s.length) });
         }, ms);
       }),
     };

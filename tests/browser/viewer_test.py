@@ -177,13 +177,20 @@ class LargeReplay(unittest.TestCase):
                 load_ms = page.evaluate("cairnViewer.loadMilliseconds")
                 self.assertEqual(page.evaluate("cairnViewer.drawnInstances()"), 1001)
                 frames = page.evaluate("cairnViewer.measureFrames(5000)", timeout=60)
+                with open("/proc/loadavg") as f:
+                    load_average = f.read().split()[0]
                 print("load %.0f ms (navigation start to first frame drawn); playing: %.1f frames/s, "
-                      "mean frame %.1f ms, 95th percentile %.1f ms over %d frames"
-                      % (load_ms, frames["fps"], frames["meanMs"], frames["p95Ms"], frames["frames"]))
+                      "mean frame %.1f ms, 95th percentile %.1f ms over %d frames; page script %.2f ms per frame; "
+                      "machine load average %s" % (load_ms, frames["fps"], frames["meanMs"], frames["p95Ms"],
+                                                   frames["frames"], frames["scriptMs"], load_average))
                 self.assertEqual(page.errors, [])
-                # Generous bounds for a shared 2-core machine (software WebGL).
+                # Generous bounds for a shared 2-core machine: Chromium draws
+                # with SwiftShader (software WebGL), whose speed depends on
+                # the machine's load; the page's own script must stay well
+                # inside a 60 Hz frame (16.7 ms).
                 self.assertLess(load_ms, 15000)
-                self.assertGreater(frames["fps"], 10)
+                self.assertGreater(frames["fps"], 5)
+                self.assertLess(frames["scriptMs"], 8)
 
 
 def main():

@@ -22,7 +22,8 @@ var CairnViewer = CairnViewer || {};
     speed.onchange = () => { this.speed = Number(speed.value); };
     this.slider.oninput = () => { this.time = replay.cairn.time[Number(this.slider.value)]; };
     document.addEventListener('keydown', (e) => {
-      if (e.target.tagName === 'SELECT') return;
+      // The speed list and the focused slider handle their own keys.
+      if (e.target.tagName === 'SELECT' || (e.target === this.slider && e.key !== ' ')) return;
       if (e.key === ' ') { this.setPlaying(!this.playing); e.preventDefault(); }
       else if (e.key === 'ArrowLeft') { this.step(-1); e.preventDefault(); }
       else if (e.key === 'ArrowRight') { this.step(1); e.preventDefault(); }

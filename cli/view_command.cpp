@@ -63,24 +63,6 @@ std::string megabytes(std::size_t bytes) {
   return buf;
 }
 
-// Runs the scene, recording a frame after every step. Returns 3 (and
-// prints the body and stage) when a non-finite state stops the run.
-int record(const SceneArg& in, Replay& replay) {
-  World world = buildWorld(in.scene);
-  validation::ReplayRecorder recorder(world, in.scene.dt, replay);
-  for (int s = 1; s <= in.scene.steps; ++s) {
-    world.step(in.scene.dt);
-    if (!world.numericalEvents().empty()) {
-      const auto& ev = world.numericalEvents().front();
-      std::cerr << "cairn view: " << in.source << ": body '" << ev.body_name << "': non-finite state in " << ev.stage
-                << " at step " << s << "; nothing written\n";
-      return 3;
-    }
-    recorder.record(world);
-  }
-  return 0;
-}
-
 int view(const ViewOptions& opt) {
   SceneArg in;
   Replay replay;
@@ -102,7 +84,7 @@ int view(const ViewOptions& opt) {
     if (!dir.empty() && !fs::is_directory(dir, ec)) throw InputError(opt.out, "", "its directory does not exist");
     if (from_csv) {
       csv_text = readFile(opt.csv);
-      replay = validation::describeWorld(buildWorld(in.scene), in.scene.dt);
+      replay = validation::describeScene(in.scene);
       validation::readRunCsv(csv_text, opt.csv, replay);
       replay.source = opt.csv + " (trajectory of " + in.source + ")";
       replay.notes.push_back("Replayed from a trajectory CSV: contacts, joints, sleep and islands are recorded only "
@@ -119,7 +101,11 @@ int view(const ViewOptions& opt) {
     if (!opt.run) std::cout << "no RUN.csv given: running " << in.name << " (as --run)\n";
     std::cout << "running " << in.name << ": " << in.scene.bodies.size() << " bodies, " << in.scene.steps
               << " steps...\n" << std::flush;
-    if (const int status = record(in, replay)) return status;
+    const std::string failure = validation::recordRun(in.scene, replay);
+    if (!failure.empty()) {
+      std::cerr << "cairn view: " << in.source << ": " << failure << "; nothing written\n";
+      return 3;
+    }
     validation::fitContacts(replay);
     replay.source = in.source + ", run by cairn view";
   }

@@ -9,6 +9,8 @@
 // to frame while the island does.
 #include "validation/replay_record.hpp"
 
+#include "world/world.hpp"
+
 #include <numeric>
 
 namespace cairn::validation {
@@ -48,6 +50,22 @@ Replay describeWorld(const World& world, Real dt) {
     r.joints.push_back(ReplayJoint{d.name, d.type, d.body_a.index, d.body_b.index});
   }
   return r;
+}
+
+Replay describeScene(const SceneDesc& scene) { return describeWorld(buildWorld(scene), scene.dt); }
+
+std::string recordRun(const SceneDesc& scene, Replay& out) {
+  World world = buildWorld(scene);
+  ReplayRecorder recorder(world, scene.dt, out);
+  for (int s = 1; s <= scene.steps; ++s) {
+    world.step(scene.dt);
+    if (!world.numericalEvents().empty()) {
+      const NumericalEvent& ev = world.numericalEvents().front();
+      return "body '" + ev.body_name + "': non-finite state in " + ev.stage + " at step " + std::to_string(s);
+    }
+    recorder.record(world);
+  }
+  return "";
 }
 
 ReplayRecorder::ReplayRecorder(const World& world, Real dt, Replay& out) : out_(out) {

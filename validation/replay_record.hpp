@@ -5,14 +5,27 @@
 // the islands.
 #pragma once
 
+#include "cairn/scene.hpp"
 #include "validation/replay.hpp"
-#include "world/world.hpp"
+
+#include <string>
+
+namespace cairn {
+class World;
+}
 
 namespace cairn::validation {
 
 // The bodies (shapes relative to the center of mass, as the World keeps
 // them), the joints and the settings of `world`, with no frames.
 Replay describeWorld(const World& world, Real dt);
+// The same for the World `scene` builds (throws InputError as buildWorld).
+Replay describeScene(const SceneDesc& scene);
+
+// Runs `scene` for scene.steps steps, recording every step into `out`.
+// Returns "" or why the run stopped early (a non-finite state: the body,
+// the stage and the step); `out` then holds the frames before it.
+std::string recordRun(const SceneDesc& scene, Replay& out);
 
 class ReplayRecorder {
  public:

@@ -12,6 +12,7 @@
 #include "validation/replay_page.hpp"
 #include "validation/replay_record.hpp"
 #include "world/scene_json.hpp"
+#include "world/world.hpp"
 
 #include <gtest/gtest.h>
 
@@ -193,7 +194,7 @@ TEST(CairnView, ReplaysARunCsvExactlyAsTheRunRecordedIt) {
   const std::string plain = ",box, \"one\",", quoted = ",\"box, \"\"one\"\"\",";
   for (size_t at = csv.find(plain); at != std::string::npos; at = csv.find(plain, at + quoted.size()))
     csv.replace(at, plain.size(), quoted);
-  Replay fromCsv = validation::describeWorld(buildWorld(scene), scene.dt);
+  Replay fromCsv = validation::describeScene(scene);
   validation::readRunCsv(csv, "run.csv", fromCsv);
   ASSERT_EQ(fromCsv.cairn.frames(), direct.cairn.frames());
   EXPECT_EQ(fromCsv.cairn.position, direct.cairn.position);

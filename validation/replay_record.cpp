@@ -1,6 +1,10 @@
-// Everything the viewer knows about a running World is read here, through
-// the World's public accessors only: bodies(), isAsleep(), contacts(),
-// joint(), jointError(), jointFeedback(), settings(), gravity(), time().
+// Everything the viewer knows about a running World is read here: its
+// settings, gravity and time through the public face, and through the
+// internals cairn's own tools reach (world/world_access.hpp) the bodies
+// (pose of the center of mass, velocities, sleep, shapes relative to the
+// center of mass), the contacts (points, normal, impulses) and the joints
+// (frames, error, force feedback). Body i of a replay is the World's body
+// slot i.
 //
 // Islands are derived as world/islands.cpp builds them: dynamic bodies
 // linked by enabled contacts or unbroken joints, static and kinematic
@@ -9,7 +13,7 @@
 // to frame while the island does.
 #include "validation/replay_record.hpp"
 
-#include "world/world.hpp"
+#include "world/world_access.hpp"
 
 #include <numeric>
 
@@ -28,11 +32,11 @@ std::int32_t root(std::vector<std::int32_t>& parent, std::int32_t i) {
 
 // A point given in a body's frame (from its center of mass), in the world;
 // the world's own points are already world points.
-Vec3 worldPoint(const World& w, BodyId id, const Vec3& local) {
+Vec3 worldPoint(const detail::WorldImpl& w, BodyId id, const Vec3& local) {
   return id.isWorld() ? local : w.body(id).transform().apply(local);
 }
 
-Vec3 worldAxis(const World& w, BodyId id, const Vec3& local) {
+Vec3 worldAxis(const detail::WorldImpl& w, BodyId id, const Vec3& local) {
   return id.isWorld() ? local : Vec3(w.body(id).orientation * local);
 }
 
@@ -43,10 +47,11 @@ Replay describeWorld(const World& world, Real dt) {
   r.dt = dt;
   r.substeps = world.settings().substeps;
   r.gravity = world.gravity();
-  for (const Body& b : world.bodies())
+  const detail::WorldImpl& w = detail::internals(world);
+  for (const Body& b : w.bodies())
     r.bodies.push_back(ReplayBody{b.name, b.type, b.isDynamic() ? double(b.mass) : 0.0, b.shapes, b.position, b.orientation});
-  for (int j = 0; j < world.jointCount(); ++j) {
-    const JointDef& d = world.joint(JointId{j}).def;
+  for (int j = 0; j < w.jointSlots(); ++j) {
+    const JointDef& d = w.joint(JointId{j}).def;
     r.joints.push_back(ReplayJoint{d.name, d.type, d.body_a.index, d.body_b.index});
   }
   return r;
@@ -79,7 +84,8 @@ ReplayRecorder::ReplayRecorder(const World& world, Real dt, Replay& out) : out_(
 void ReplayRecorder::record(const World& world) {
   ReplayTrack& t = out_.cairn;
   ReplayOverlays& o = out_.overlays;
-  const auto& bodies = world.bodies();
+  const detail::WorldImpl& w = detail::internals(world);
+  const auto& bodies = w.bodies();
   t.time.push_back(world.time());
   for (size_t i = 0; i < bodies.size(); ++i) {
     const Body& b = bodies[i];
@@ -88,24 +94,24 @@ void ReplayRecorder::record(const World& world) {
                                                float(b.orientation.z()), float(b.orientation.w())});
     put(t.velocity, b.linear_velocity);
     put(t.angular_velocity, b.angular_velocity);
-    o.asleep.push_back(world.isAsleep(BodyId{std::int32_t(i)}) ? 1 : 0);
+    o.asleep.push_back(b.asleep ? 1 : 0);
   }
 
   parent_.resize(bodies.size());
   std::iota(parent_.begin(), parent_.end(), 0);
   const auto link = [&](BodyId a, BodyId b) {
-    if (a.isWorld() || b.isWorld() || !world.body(a).isDynamic() || !world.body(b).isDynamic()) return;
+    if (a.isWorld() || b.isWorld() || !w.body(a).isDynamic() || !w.body(b).isDynamic()) return;
     const std::int32_t ra = root(parent_, a.index), rb = root(parent_, b.index);
     parent_[size_t(std::max(ra, rb))] = std::min(ra, rb);
   };
-  for (const Contact& c : world.contacts()) {
+  for (const Contact& c : w.contacts()) {
     if (!c.enabled) continue;
     link(c.body_a, c.body_b);
     if (!c.touching || c.count == 0) continue;
     Vec3 friction = Vec3::Zero();
     for (int p = 0; p < c.count; ++p) {
       const ContactPointState& s = c.points[p];
-      put(o.point_position, (worldPoint(world, c.body_a, s.local_a) + worldPoint(world, c.body_b, s.local_b)) / 2);
+      put(o.point_position, (worldPoint(w, c.body_a, s.local_a) + worldPoint(w, c.body_b, s.local_b)) / 2);
       o.point_impulse.push_back(float(s.normal_impulse));
       friction += s.friction_impulse;
     }
@@ -118,15 +124,15 @@ void ReplayRecorder::record(const World& world) {
   o.manifold_begin.push_back(std::uint32_t(o.manifold_points.size()));
   o.point_begin.push_back(std::uint32_t(o.point_impulse.size()));
 
-  for (int j = 0; j < world.jointCount(); ++j) {
-    const Joint& jt = world.joint(JointId{j});
-    if (!jt.broken) link(jt.def.body_a, jt.def.body_b);
-    put(o.joint_anchor_a, worldPoint(world, jt.def.body_a, jt.local_anchor_a));
-    put(o.joint_anchor_b, worldPoint(world, jt.def.body_b, jt.local_anchor_b));
-    put(o.joint_axis, worldAxis(world, jt.def.body_a, jt.local_axis_a));
-    const JointError e = world.jointError(JointId{j});
+  for (int j = 0; j < w.jointSlots(); ++j) {
+    const Joint& jt = w.joint(JointId{j});
+    if (jt.alive && !jt.broken) link(jt.def.body_a, jt.def.body_b);
+    put(o.joint_anchor_a, worldPoint(w, jt.def.body_a, jt.local_anchor_a));
+    put(o.joint_anchor_b, worldPoint(w, jt.def.body_b, jt.local_anchor_b));
+    put(o.joint_axis, worldAxis(w, jt.def.body_a, jt.local_axis_a));
+    const JointError e = w.jointError(JointId{j});
     o.joint_error.insert(o.joint_error.end(), {float(e.linear), float(e.angular)});
-    const JointFeedback& f = world.jointFeedback(JointId{j});
+    const JointFeedback& f = w.jointFeedback(JointId{j});
     put(o.joint_force_a, f.force_a);
     put(o.joint_force_b, f.force_b);
   }

@@ -12,7 +12,7 @@
 #include "validation/replay_page.hpp"
 #include "validation/replay_record.hpp"
 #include "world/scene_json.hpp"
-#include "world/world.hpp"
+#include "cairn/world.hpp"
 
 #include <gtest/gtest.h>
 

@@ -234,8 +234,9 @@ bool CairnRunner::step(int s) {
   return true;
 }
 
-BulletRunner::BulletRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out)
-    : dt_(scene.dt), shadow_(buildWorld(scene)), oracle_(std::make_unique<BulletOracle>(scene)),
+BulletRunner::BulletRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out,
+                           const OracleOptions& options)
+    : dt_(scene.dt), shadow_(buildWorld(scene)), oracle_(std::make_unique<BulletOracle>(scene, options)),
       recorder_(scene, spec), out_(out) {
   running_ = copyStates(*oracle_, shadow_);
   if (running_) recorder_.record(shadow_, 0, 0, out_);
@@ -258,6 +259,16 @@ bool BulletRunner::step(int s) {
 
 const std::vector<std::string>& BulletRunner::skipped() const { return oracle_->skipped(); }
 
+int BulletRunner::sleepingBodies() const { return oracle_->sleepingBodies(); }
+
+void runDirectReference(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out) {
+  SceneDesc exact = scene;
+  exact.solver.method = SolverMethod::Direct;
+  CairnRunner reference(exact, spec, out);
+  for (int s = 1; s <= scene.steps; ++s)
+    if (!reference.step(s)) break;
+}
+
 void runEngines(SceneResult& r) {
   // One step each in turn, so both runs see the machine in the same state.
   CairnRunner cairn(r.scene, r.spec, r.cairn);
@@ -267,13 +278,8 @@ void runEngines(SceneResult& r) {
     bullet.step(s);
   }
   r.skipped = bullet.skipped();
-  if (r.spec.direct_reference) {  // the exact bilateral solve of the same scene, after the timed runs
-    SceneDesc exact = r.scene;
-    exact.solver.method = SolverMethod::Direct;
-    CairnRunner reference(exact, r.spec, r.reference);
-    for (int s = 1; s <= r.scene.steps; ++s)
-      if (!reference.step(s)) break;
-  }
+  // The exact bilateral solve of the same scene, after the timed runs.
+  if (r.spec.direct_reference) runDirectReference(r.scene, r.spec, r.reference);
 }
 
 SceneResult validateScene(const SceneDesc& scene, const std::string& name, const std::string& source,

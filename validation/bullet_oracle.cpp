@@ -318,6 +318,7 @@ void BulletOracle::Impl::addBody(const Body& cb, const BodyDef& def, int index) 
   rec.w = cb.angular_velocity;
   const std::string who = "body '" + cb.name + "'";
   const bool match = options.match_cairn;
+  const MarginRule margins = match ? MarginRule::Thin : MarginRule::BulletDefault;
 
   const auto shapeName = [&](size_t k) { return who + " shapes[" + std::to_string(k) + "]"; };
   for (size_t k = 0; k < cb.shapes.size(); ++k)
@@ -340,7 +341,7 @@ void BulletOracle::Impl::addBody(const Body& cb, const BodyDef& def, int index) 
     if (cb.shapes.empty()) make(shapes.make<btEmptyShape>(), t);
     for (size_t k = 0; k < cb.shapes.size(); ++k) {
       const ShapeDesc& s = cb.shapes[k];
-      make(makeShape(s, shapes, skipped, shapeName(k)), t * toBt(s.local.p, s.local.q));
+      make(makeShape(s, shapes, skipped, shapeName(k), margins), t * toBt(s.local.p, s.local.q));
     }
     bodies.push_back(rec);
     return;
@@ -355,13 +356,13 @@ void BulletOracle::Impl::addBody(const Body& cb, const BodyDef& def, int index) 
     shape = shapes.make<btEmptyShape>();
   } else if (cb.shapes.size() == 1 && isIdentity(Transform{to_bullet * cb.shapes[0].local.p,
                                                            to_bullet * cb.shapes[0].local.q})) {
-    shape = makeShape(cb.shapes[0], shapes, skipped, shapeName(0));
+    shape = makeShape(cb.shapes[0], shapes, skipped, shapeName(0), margins);
   } else {
     auto* compound = shapes.make<btCompoundShape>();
     for (size_t k = 0; k < cb.shapes.size(); ++k) {
       const ShapeDesc& s = cb.shapes[k];
       compound->addChildShape(toBt(to_bullet * s.local.p, (to_bullet * s.local.q).normalized()),
-                              makeShape(s, shapes, skipped, shapeName(k)));
+                              makeShape(s, shapes, skipped, shapeName(k), margins));
     }
     shape = compound;
   }

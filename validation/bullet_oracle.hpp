@@ -41,7 +41,8 @@ struct OracleOptions {
   // bounce as cairn defines them.
   // false: Bullet as it ships: btContactSolverInfo defaults (except the
   // iteration count and the step), product friction and restitution,
-  // Bullet's own damping law and joint parameter conventions.
+  // Bullet's own damping law and joint parameter conventions, and its
+  // default 0.04 m margin on boxes and cylinders down to 0.08 m thick.
   bool match_cairn = true;
   // false: the scene's solver.sleeping decides (off: every dynamic body
   // DISABLE_DEACTIVATION; on: the scene's speed thresholds and sleep time).

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   cairn::cli::addScenesCommand(app, status);
   cairn::cli::addValidateCommand(app, status);
   cairn::cli::addSweepCommand(app, status);
+  cairn::cli::addBenchCommand(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

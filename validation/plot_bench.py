@@ -63,6 +63,7 @@ def by_scene_engine(rows):
 def grouped_bars(ax, scenes, table, column, log=True, annotate_ratio=False):
     width = 0.8 / len(ENGINES)
     drawn = False
+    zeros = []  # a log scale has no bar for 0: marked "0" at the bottom instead
     for k, engine in enumerate(ENGINES):
         xs, ys = [], []
         for i, scene in enumerate(scenes):
@@ -70,6 +71,8 @@ def grouped_bars(ax, scenes, table, column, log=True, annotate_ratio=False):
             if math.isfinite(v) and (v > 0 or not log):
                 xs.append(i + (k - 1) * width)
                 ys.append(v)
+            elif v == 0:
+                zeros.append((i + (k - 1) * width, engine))
         if not xs:
             continue
         drawn = True
@@ -84,6 +87,9 @@ def grouped_bars(ax, scenes, table, column, log=True, annotate_ratio=False):
     ax.set_xticklabels(scenes, rotation=30, ha="right")
     if log and drawn:
         ax.set_yscale("log")
+        bottom = ax.get_ylim()[0]
+        for x, engine in zeros:
+            ax.annotate("0", (x, bottom), ha="center", va="bottom", fontsize=8, color=COLORS[engine])
     ax.grid(True, axis="y", which="both", alpha=0.3)
     return drawn
 

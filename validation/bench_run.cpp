@@ -107,7 +107,9 @@ Figures figuresOf(const Measured& m, const SceneDesc& scene, const ValidationSpe
   if (rest == RestFrom::LastSecond) {
     SceneDesc ran = scene;
     ran.steps = steps;
-    f.rest = largestDisplacement(scene, run, lastSecondStart(ran), steps);
+    const int from = lastSecondStart(ran);
+    // A run that stopped early may have had that sample thinned away.
+    if (!run.positions[size_t(from)].empty()) f.rest = largestDisplacement(scene, run, from, steps);
   }
   if (!run.penetration.empty()) f.penetration = maxSince(run, run.penetration, std::max(0.0, duration - 1));
   if (!scene.joints.empty()) f.joint_error = maxSince(run, run.joint_error, 0);

@@ -1,6 +1,6 @@
 #include "validation/bench_world.hpp"
 
-#include "world/world.hpp"
+#include "cairn/world.hpp"
 
 namespace cairn::validation {
 

@@ -1,6 +1,6 @@
 // The `cairn` subcommands. Each returns the process exit status:
 //   0 success, 1 a check failed (validate), 2 bad input (nothing written),
-//   3 a non-finite state was caught during the run.
+//   3 a non-finite state was caught during the run (run, bench).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -13,5 +13,6 @@ void addScenesCommand(CLI::App& app, int& status);
 void addValidateCommand(CLI::App& app, int& status);
 void addSweepCommand(CLI::App& app, int& status);
 void addViewCommand(CLI::App& app, int& status);
+void addBenchCommand(CLI::App& app, int& status);
 
 }  // namespace cairn::cli

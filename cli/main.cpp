@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   cairn::cli::addValidateCommand(app, status);
   cairn::cli::addSweepCommand(app, status);
   cairn::cli::addViewCommand(app, status);
+  cairn::cli::addBenchCommand(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -17,11 +17,10 @@
 #include "cli/solver_overrides.hpp"
 #include "cairn/error.hpp"
 #include "validation/compare.hpp"
+#include "validation/machine.hpp"
 #include "validation/plot_script.hpp"
 #include "validation/report.hpp"
 
-#include <chrono>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -41,15 +40,6 @@ struct ValidateOptions {
   std::optional<int> steps;
   SolverOverrides solver;
 };
-
-std::string utcNow() {
-  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[64];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", &tm);
-  return buf;
-}
 
 std::string commandLine(const ValidateOptions& opt) {
   std::string cmd = "cairn validate";
@@ -98,7 +88,7 @@ int validate(const ValidateOptions& opt) {
   if (!opt.report.empty()) {
     validation::ReportInfo info;
     info.command = commandLine(opt);
-    info.date = utcNow();
+    info.date = validation::utcNow();
     info.plot_script = validation::findPlotScript("plot_report.py");
     try {
       const std::string warning = validation::writeReport(opt.report, results, info);

@@ -45,10 +45,18 @@ struct ShapeStore {
   }
 };
 
+// The collision margin of boxes and cylinders (bullet_shapes.cpp):
+//   Thin          a quarter of the smallest half size for any shape thinner
+//                 than 0.16 m, so the rounding stays small beside the shape
+//   BulletDefault Bullet's 0.04 m, as a program that never sets it gets;
+//                 only below 0.04 m of half size, where Bullet's core would
+//                 turn inside out, the quarter rule (with a note)
+enum class MarginRule { Thin, BulletDefault };
+
 // The Bullet shape of `s` in its own frame (s.local is applied by the
 // caller). `who` names the body for notes ("body 'crate' shapes[1]").
 btCollisionShape* makeShape(const ShapeDesc& s, ShapeStore& store, std::vector<std::string>& notes,
-                            const std::string& who);
+                            const std::string& who, MarginRule margins = MarginRule::Thin);
 
 // Radius of a sphere that fits inside the shape (for Bullet's swept-sphere
 // CCD); 0 for planes and meshes.

@@ -93,6 +93,9 @@ const char* correctionName(Correction c) {
   return "unknown";
 }
 
+// gDeactivationTime's initial value (btRigidBody.cpp).
+constexpr btScalar kBulletDeactivationTime = 2;
+
 std::string fmt(Real v) {
   std::ostringstream s;
   s << v;
@@ -231,7 +234,11 @@ void BulletOracle::Impl::configureSolver() {
   if (std::isfinite(s.max_correction_velocity))
     skipped.push_back("solver.max_correction_velocity=" + fmt(s.max_correction_velocity) +
                       " m/s not mapped: Bullet does not clamp the ERP or split-impulse push-out velocity");
-  if (s.sleeping) {
+  if (options.bullet_deactivation) {
+    gDeactivationTime = kBulletDeactivationTime;  // process-global: undo what another oracle set
+    skipped.push_back("bullet_deactivation: Bullet's own deactivation (0.8 m/s, 1 rad/s, gDeactivationTime 2 s) "
+                      "whatever solver.sleeping says");
+  } else if (s.sleeping) {
     gDeactivationTime = s.sleep_time;  // Bullet's is process-global
     skipped.push_back("solver.sleeping approximated: Bullet deactivates an island whose bodies all stayed below the "
                       "speed thresholds for gDeactivationTime = " + fmt(s.sleep_time) +
@@ -292,10 +299,12 @@ btRigidBody* BulletOracle::Impl::addRigidBody(const btRigidBody::btRigidBodyCons
   }
   // The group and mask bit patterns as Bullet's int filter fields.
   world->addRigidBody(rb, static_cast<int>(def.collision_group), static_cast<int>(def.collision_mask));
-  if (def.type == BodyType::Kinematic || (def.type == BodyType::Dynamic && !solver.sleeping))
-    rb->setActivationState(DISABLE_DEACTIVATION);  // no sleeping unless the scene sleeps
-  else if (def.type == BodyType::Dynamic)
-    rb->setSleepingThresholds(solver.sleep_linear_velocity, solver.sleep_angular_velocity);
+  if (def.type == BodyType::Kinematic) {
+    rb->setActivationState(DISABLE_DEACTIVATION);  // the oracle drives it every step
+  } else if (def.type == BodyType::Dynamic && !options.bullet_deactivation) {
+    if (!solver.sleeping) rb->setActivationState(DISABLE_DEACTIVATION);  // no sleeping unless the scene sleeps
+    else rb->setSleepingThresholds(solver.sleep_linear_velocity, solver.sleep_angular_velocity);
+  }
   return rb;
 }
 
@@ -309,6 +318,7 @@ void BulletOracle::Impl::addBody(const Body& cb, const BodyDef& def, int index) 
   rec.w = cb.angular_velocity;
   const std::string who = "body '" + cb.name + "'";
   const bool match = options.match_cairn;
+  const MarginRule margins = match ? MarginRule::Thin : MarginRule::BulletDefault;
 
   const auto shapeName = [&](size_t k) { return who + " shapes[" + std::to_string(k) + "]"; };
   for (size_t k = 0; k < cb.shapes.size(); ++k)
@@ -331,7 +341,7 @@ void BulletOracle::Impl::addBody(const Body& cb, const BodyDef& def, int index) 
     if (cb.shapes.empty()) make(shapes.make<btEmptyShape>(), t);
     for (size_t k = 0; k < cb.shapes.size(); ++k) {
       const ShapeDesc& s = cb.shapes[k];
-      make(makeShape(s, shapes, skipped, shapeName(k)), t * toBt(s.local.p, s.local.q));
+      make(makeShape(s, shapes, skipped, shapeName(k), margins), t * toBt(s.local.p, s.local.q));
     }
     bodies.push_back(rec);
     return;
@@ -346,13 +356,13 @@ void BulletOracle::Impl::addBody(const Body& cb, const BodyDef& def, int index) 
     shape = shapes.make<btEmptyShape>();
   } else if (cb.shapes.size() == 1 && isIdentity(Transform{to_bullet * cb.shapes[0].local.p,
                                                            to_bullet * cb.shapes[0].local.q})) {
-    shape = makeShape(cb.shapes[0], shapes, skipped, shapeName(0));
+    shape = makeShape(cb.shapes[0], shapes, skipped, shapeName(0), margins);
   } else {
     auto* compound = shapes.make<btCompoundShape>();
     for (size_t k = 0; k < cb.shapes.size(); ++k) {
       const ShapeDesc& s = cb.shapes[k];
       compound->addChildShape(toBt(to_bullet * s.local.p, (to_bullet * s.local.q).normalized()),
-                              makeShape(s, shapes, skipped, shapeName(k)));
+                              makeShape(s, shapes, skipped, shapeName(k), margins));
     }
     shape = compound;
   }
@@ -575,6 +585,13 @@ Vec3 BulletOracle::jointAnchorSeparation(int joint) const {
 bool BulletOracle::jointActive(int joint) const {
   const Impl::JointRecord& j = impl_->joints.at(static_cast<size_t>(joint));
   return j.added && j.built.constraint->isEnabled();
+}
+
+int BulletOracle::sleepingBodies() const {
+  int n = 0;
+  for (const Impl::BodyRecord& b : impl_->bodies)
+    if (b.type == BodyType::Dynamic && b.rb->getActivationState() == ISLAND_SLEEPING) ++n;
+  return n;
 }
 
 double BulletOracle::lastStepSeconds() const { return impl_->last_step_seconds; }

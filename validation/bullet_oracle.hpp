@@ -41,8 +41,17 @@ struct OracleOptions {
   // bounce as cairn defines them.
   // false: Bullet as it ships: btContactSolverInfo defaults (except the
   // iteration count and the step), product friction and restitution,
-  // Bullet's own damping law and joint parameter conventions.
+  // Bullet's own damping law and joint parameter conventions, and its
+  // default 0.04 m margin on boxes and cylinders down to 0.08 m thick.
   bool match_cairn = true;
+  // false: the scene's solver.sleeping decides (off: every dynamic body
+  // DISABLE_DEACTIVATION; on: the scene's speed thresholds and sleep time).
+  // true: Bullet's own deactivation whatever the scene says, as a program
+  // that never touches it gets: btRigidBodyConstructionInfo's thresholds
+  // 0.8 m/s and 1 rad/s, and gDeactivationTime 2 s (btRigidBody.cpp). That
+  // time is a process-global: this oracle sets it back to 2 s, so two
+  // oracles that want different times must not be alive at once.
+  bool bullet_deactivation = false;
 };
 
 class BulletOracle {
@@ -76,6 +85,9 @@ class BulletOracle {
   Vec3 jointAnchorSeparation(int joint) const;
   // False once Bullet broke the joint (or when it could not be built).
   bool jointActive(int joint) const;
+
+  // Dynamic bodies Bullet has deactivated (ISLAND_SLEEPING) after the last step.
+  int sleepingBodies() const;
 
   double lastStepSeconds() const;  // wall time of the last step()
   int stepCount() const;

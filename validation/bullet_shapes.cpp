@@ -7,7 +7,9 @@
 //                     exact, edges and corners are rounded with r = 0.04.
 //                     A box or cylinder thinner than 0.16 m gets a smaller
 //                     margin (a quarter of its smallest half size) so that
-//                     the core never inverts.
+//                     the rounding stays small beside it; with
+//                     MarginRule::BulletDefault only one thinner than
+//                     0.08 m does, whose core would otherwise invert.
 //   convex hull       Bullet adds the margin outside the points, so the hull
 //                     is first shrunk by the margin (btConvexHullComputer moves
 //                     every face inward); shrunk core + margin = the hull with
@@ -31,7 +33,13 @@ namespace {
 constexpr Real kDefaultMargin = Real(0.04);  // CONVEX_DISTANCE_MARGIN
 
 // Keeps the margin inside thin boxes and cylinders.
-Real insideMargin(Real smallest_half_size) { return std::min(kDefaultMargin, Real(0.25) * smallest_half_size); }
+Real insideMargin(Real smallest_half_size, MarginRule rule, std::vector<std::string>& notes, const std::string& who) {
+  if (rule == MarginRule::Thin || smallest_half_size >= kDefaultMargin)
+    return rule == MarginRule::Thin ? std::min(kDefaultMargin, Real(0.25) * smallest_half_size) : kDefaultMargin;
+  notes.push_back(who + ": thinner than Bullet's default margin allows (0.08 m); margin a quarter of its smallest "
+                        "half size instead of 0.04 m");
+  return Real(0.25) * smallest_half_size;
+}
 
 btCollisionShape* makeHull(const ConvexHullData& hull, ShapeStore& store, std::vector<std::string>& notes,
                            const std::string& who) {
@@ -60,13 +68,13 @@ btCollisionShape* makeHull(const ConvexHullData& hull, ShapeStore& store, std::v
 }  // namespace
 
 btCollisionShape* makeShape(const ShapeDesc& s, ShapeStore& store, std::vector<std::string>& notes,
-                            const std::string& who) {
+                            const std::string& who, MarginRule margins) {
   switch (s.type) {
     case ShapeType::Sphere:
       return store.make<btSphereShape>(s.radius);
     case ShapeType::Box: {
       auto* box = store.make<btBoxShape>(toBt(s.half_extents));
-      const Real m = insideMargin(s.half_extents.minCoeff());
+      const Real m = insideMargin(s.half_extents.minCoeff(), margins, notes, who);
       if (m != kDefaultMargin) box->setMargin(m);  // setMargin keeps the outer size
       return box;
     }
@@ -75,7 +83,7 @@ btCollisionShape* makeShape(const ShapeDesc& s, ShapeStore& store, std::vector<s
       return store.make<btCapsuleShape>(s.radius, 2 * s.half_height);  // along y
     case ShapeType::Cylinder: {
       auto* cyl = store.make<btCylinderShape>(btVector3(s.radius, s.half_height, s.radius));  // along y
-      const Real m = insideMargin(std::min(s.radius, s.half_height));
+      const Real m = insideMargin(std::min(s.radius, s.half_height), margins, notes, who);
       if (m != kDefaultMargin) cyl->setMargin(m);
       return cyl;
     }

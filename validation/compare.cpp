@@ -454,6 +454,27 @@ double measurePeriod(const std::vector<double>& t, const std::vector<double>& x)
   return (crossings.back() - crossings.front()) / double(crossings.size() - 1);
 }
 
+double largestDisplacement(const SceneDesc& scene, const EngineRun& run, int from, int to) {
+  double m = 0;
+  for (size_t i = 0; i < scene.bodies.size(); ++i)
+    if (scene.bodies[i].type == BodyType::Dynamic)
+      m = std::max(m, (run.positions[size_t(to)][i] - run.positions[size_t(from)][i]).norm());
+  return m;
+}
+
+double maxSince(const EngineRun& run, const std::vector<double>& v, double t_from) {
+  double m = 0;
+  for (int s = 0; s < run.samples() && s < int(v.size()); ++s)
+    if (run.time[size_t(s)] >= t_from - 1e-9) m = std::max(m, v[size_t(s)]);
+  return m;
+}
+
+double referenceDistance(const EngineRun& run, const EngineRun& reference, const ValidationSpec& spec,
+                         double duration) {
+  const bool limited = spec.horizon > 0 && spec.horizon < duration;
+  return trajectoryDifference(run, reference, limited ? spec.horizon : 0).position;
+}
+
 namespace {
 
 int bodyIndexOf(const SceneDesc& scene, const std::string& name) { return scene.bodyIndex(name); }
@@ -466,13 +487,6 @@ bool contactsPossible(const EngineRun& run) { return !run.penetration.empty(); }
 
 double last(const std::vector<double>& v) { return v.empty() ? std::numeric_limits<double>::quiet_NaN() : v.back(); }
 
-// Largest value over the samples with time >= t_from.
-double maxSince(const EngineRun& run, const std::vector<double>& v, double t_from) {
-  double m = 0;
-  for (int s = 0; s < run.samples() && s < int(v.size()); ++s)
-    if (run.time[size_t(s)] >= t_from - 1e-9) m = std::max(m, v[size_t(s)]);
-  return m;
-}
 
 double maxAbsChange(const std::vector<double>& v) {
   double m = 0;
@@ -481,13 +495,7 @@ double maxAbsChange(const std::vector<double>& v) {
 }
 
 // Largest displacement of any dynamic body from its start, at sample s.
-double displacementAt(const SceneDesc& scene, const EngineRun& run, int s) {
-  double m = 0;
-  for (size_t i = 0; i < scene.bodies.size(); ++i)
-    if (scene.bodies[i].type == BodyType::Dynamic)
-      m = std::max(m, (run.positions[size_t(s)][i] - run.positions[0][i]).norm());
-  return m;
-}
+double displacementAt(const SceneDesc& scene, const EngineRun& run, int s) { return largestDisplacement(scene, run, 0, s); }
 
 std::string fmt(const char* f, double v) {
   char buf[64];
@@ -594,9 +602,7 @@ std::vector<Figure> compareRuns(const SceneDesc& scene, const ValidationSpec& sp
         .note = where(d.angle_body, d.angle_sample);
     if (reference != nullptr && reference->samples() > 1) {
       // Each engine's distance from the exact-solve trajectory, side by side.
-      const auto from_reference = [&](const EngineRun& r) {
-        return trajectoryDifference(r, *reference, limited ? spec.horizon : 0).position;
-      };
+      const auto from_reference = [&](const EngineRun& r) { return referenceDistance(r, *reference, spec, duration); };
       const Pair ref = both(cairn, bullet, from_reference);
       add("reference_distance", "largest distance from the exact bilateral solve (cairn, method direct)" + over, "m",
           Check::RatioBullet, ref.c, ref.b, std::nullopt, true);

@@ -26,6 +26,7 @@
 #pragma once
 
 #include "cairn/scene.hpp"
+#include "validation/bullet_oracle.hpp"
 #include "validation/replay.hpp"
 #include "world/world_access.hpp"
 
@@ -185,9 +186,15 @@ struct SceneResult {
 };
 
 // Runs `scene` in cairn and in Bullet (OracleOptions{match_cairn = true})
-// for scene.steps steps and fills cairn, bullet and skipped; with
-// record_replay also result.replay (replay_bullet.hpp).
+// for scene.steps steps and fills cairn, bullet and skipped, and the
+// reference when spec.direct_reference; with record_replay also
+// result.replay (replay_bullet.hpp).
 void runEngines(SceneResult& result, bool record_replay = false);
+
+// The reference run of a scene with "reference": "direct": cairn on the
+// same scene with method "direct" (the exact bilateral solve), recorded
+// like the others, for scene.steps steps or until it stops.
+void runDirectReference(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out);
 
 // Records samples from a cairn World: the real one, or the shadow one that
 // holds Bullet's states. One Recorder per engine (it keeps the first
@@ -233,16 +240,18 @@ class CairnRunner {
 
 class BulletOracle;
 
-// Bullet (OracleOptions{match_cairn = true}), measured through a shadow
-// cairn World that holds Bullet's states (see the top of this file).
+// Bullet (OracleOptions{match_cairn = true} unless told otherwise),
+// measured through a shadow cairn World that holds Bullet's states (see the
+// top of this file).
 class BulletRunner {
  public:
-  BulletRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out);
+  BulletRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out, const OracleOptions& options = {});
   ~BulletRunner();
   bool step(int s);
   bool running() const { return running_; }
   // What Bullet lacks or maps only approximately (BulletOracle::skipped).
   const std::vector<std::string>& skipped() const;
+  int sleepingBodies() const;  // BulletOracle::sleepingBodies
 
  private:
   Real dt_;
@@ -271,6 +280,21 @@ struct TrajectoryDifference {
 };
 // Samples after `until` seconds (when > 0) are left out.
 TrajectoryDifference trajectoryDifference(const EngineRun& a, const EngineRun& b, double until = 0);
+
+// Largest distance any dynamic body moved between samples `from` and `to`
+// (centers of mass). compareRuns's drift is from sample 0 to the last.
+double largestDisplacement(const SceneDesc& scene, const EngineRun& run, int from, int to);
+
+// Largest value of `v` over the samples of `run` at time >= t_from (0 when
+// there are none).
+double maxSince(const EngineRun& run, const std::vector<double>& v, double t_from);
+
+// A run's largest position distance from the reference run (the exact
+// bilateral solve) over the spec's horizon, or over the whole run when the
+// horizon is 0 or not shorter than `duration` (s): compareRuns's
+// reference_distance.
+double referenceDistance(const EngineRun& run, const EngineRun& reference, const ValidationSpec& spec,
+                         double duration);
 
 // Mean period of a signal from its upward crossings of its mean level,
 // linearly interpolated; 0 with fewer than two crossings.

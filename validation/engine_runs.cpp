@@ -240,8 +240,9 @@ bool CairnRunner::step(int s) {
   return true;
 }
 
-BulletRunner::BulletRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out)
-    : dt_(scene.dt), shadow_(buildWorld(scene)), oracle_(std::make_unique<BulletOracle>(scene)),
+BulletRunner::BulletRunner(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out,
+                           const OracleOptions& options)
+    : dt_(scene.dt), shadow_(buildWorld(scene)), oracle_(std::make_unique<BulletOracle>(scene, options)),
       recorder_(scene, spec), out_(out) {
   running_ = copyStates(*oracle_, shadow_);
   if (running_) recorder_.record(shadow_, 0, 0, out_);
@@ -264,6 +265,16 @@ bool BulletRunner::step(int s) {
 
 const std::vector<std::string>& BulletRunner::skipped() const { return oracle_->skipped(); }
 
+int BulletRunner::sleepingBodies() const { return oracle_->sleepingBodies(); }
+
+void runDirectReference(const SceneDesc& scene, const ValidationSpec& spec, EngineRun& out) {
+  SceneDesc exact = scene;
+  exact.solver.method = SolverMethod::Direct;
+  CairnRunner reference(exact, spec, out);
+  for (int s = 1; s <= scene.steps; ++s)
+    if (!reference.step(s)) break;
+}
+
 void runEngines(SceneResult& r, bool record_replay) {
   if (record_replay) r.replay = std::make_shared<Replay>();
   // One step each in turn, so both runs see the machine in the same state.
@@ -280,13 +291,8 @@ void runEngines(SceneResult& r, bool record_replay) {
     addBulletRun(*r.replay, r.bullet, r.spec);
     fitContacts(*r.replay);
   }
-  if (r.spec.direct_reference) {  // the exact bilateral solve of the same scene, after the timed runs
-    SceneDesc exact = r.scene;
-    exact.solver.method = SolverMethod::Direct;
-    CairnRunner reference(exact, r.spec, r.reference);
-    for (int s = 1; s <= r.scene.steps; ++s)
-      if (!reference.step(s)) break;
-  }
+  // The exact bilateral solve of the same scene, after the timed runs.
+  if (r.spec.direct_reference) runDirectReference(r.scene, r.spec, r.reference);
 }
 
 SceneResult validateScene(const SceneDesc& scene, const std::string& name, const std::string& source,

@@ -44,7 +44,9 @@ int runLogged(const std::vector<std::string>& argv, const std::string& log) {
 }  // namespace
 
 std::string findPlotScript(const std::string& name) {
-  const char* env_name = name == "plot_sweep.py" ? "CAIRN_SWEEP_PLOT_SCRIPT" : "CAIRN_PLOT_SCRIPT";
+  const char* env_name = name == "plot_sweep.py"   ? "CAIRN_SWEEP_PLOT_SCRIPT"
+                         : name == "plot_bench.py" ? "CAIRN_BENCH_PLOT_SCRIPT"
+                                                   : "CAIRN_PLOT_SCRIPT";
   if (const char* env = std::getenv(env_name)) return env;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);

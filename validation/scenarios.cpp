@@ -154,7 +154,11 @@ SceneDesc byName(const std::string& key) {
     if (starts("chain-")) return chain(std::stoi(tail("chain-")));
     if (starts("hinge-pendulum-")) return hingePendulum(std::stod(tail("hinge-pendulum-")));
     if (starts("mass-ratio-")) return massRatio(std::stod(tail("mass-ratio-")));
-    if (key == "pile-1000") return pile(10);
+    if (starts("pile-")) {
+      const int count = std::stoi(tail("pile-"));
+      const int side = static_cast<int>(std::lround(std::cbrt(double(count))));
+      if (count > 0 && side * side * side == count && std::to_string(count) == tail("pile-")) return pile(side);
+    }
     if (key == "hinge-chain") return hingeChain(5);
     if (key == "door") return door(5);
     if (key == "ragdoll") return ragdoll();

@@ -14,13 +14,13 @@
 
 namespace cairn::scenarios {
 
-SceneDesc pyramid(int base);                   // pyramid-N
+SceneDesc pyramid(int base);                   // pyramid-N (pyramid-100, 5,050 boxes: the large pyramid)
 SceneDesc column(int n);                       // column-N
 SceneDesc chain(int n);                        // chain-N, released horizontally
 SceneDesc hangingChain(int n);                 // hanging-chain-N
 SceneDesc hingePendulum(Real amplitude_rad);   // hinge-pendulum
 SceneDesc massRatio(Real ratio);               // mass-ratio-R
-SceneDesc pile(int per_side);                  // pile-1000 for per_side = 10
+SceneDesc pile(int per_side);                  // pile-N for N = per_side^3 (pile-125, pile-1000, pile-8000)
 
 // Scenarios of issue 5 beyond SCENARIOS.md's table; each sets the
 // table's common conditions itself (no sleeping).
@@ -31,8 +31,9 @@ SceneDesc ramp();                              // ramp: boxes on 20 and 35 degre
 SceneDesc restitutionDrop(Real restitution);   // restitution-drop: a sphere of e dropped 2 m on the ground
 
 // Scenario by key ("pyramid-10", "column-20", "chain-100",
-// "hinge-pendulum-0.1", "mass-ratio-1000", "pile-1000", ...); throws
-// InputError for an unknown key.
+// "hinge-pendulum-0.1", "mass-ratio-1000", "pile-1000", ...); the sized
+// families take any size ("pyramid-100", "chain-1000", "pile-8000": a pile
+// of a whole cube of boxes). Throws InputError for an unknown key.
 SceneDesc byName(const std::string& key);
 std::vector<std::string> standardNames();
 

@@ -26,6 +26,7 @@ constexpr Key kKeys[] = {
     {"contact_erp", Type::Real},  {"sor", Type::Real},          {"tolerance", Type::Real},
     {"warm_start", Type::Bool},   {"warm_start_factor", Type::Real}, {"randomize_order", Type::Bool},
     {"split_impulse", Type::Bool}, {"slop", Type::Real},        {"nncg", Type::Bool},
+    {"sleeping", Type::Bool},
 };
 
 const Key* findKey(const std::string& name) {
@@ -113,6 +114,7 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
       if (key == "warm_start") s.warm_start = v;
       else if (key == "randomize_order") s.randomize_order = v;
       else if (key == "nncg") s.nncg = v;
+      else if (key == "sleeping") s.sleeping = v;
       else s.split_impulse = v;
       break;
     }
@@ -159,6 +161,7 @@ std::string solverKeyValue(const SceneDesc& scene, const std::string& key) {
   if (key == "split_impulse") return s.split_impulse ? "true" : "false";
   if (key == "slop") return exactNumberText(s.slop);
   if (key == "nncg") return s.nncg ? "true" : "false";
+  if (key == "sleeping") return s.sleeping ? "true" : "false";
   throw InputError("solver", key, "unknown setting");
 }
 

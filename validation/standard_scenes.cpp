@@ -147,10 +147,12 @@ StandardScene standardScene(const std::string& key) {
                       "with the light box barely squeezed.";
     v = block("mass-ratio", ValidationKind::Statistics, Json::array({trace("heavy", "height"), trace("light", "height")}));
     v["top_body"] = "heavy";
-  } else if (key == "pile-1000") {
-    out.description = common + steps + ". A 10 x 10 x 10 grid of 1 m boxes (1 kg), 1.2 m apart, lowest layer at "
-                      "y = 1 m, dropped on the ground. The boxes fall, tumble and settle into a heap about 5 m high; "
-                      "what is compared is cost per step and the heap's statistics, not box-by-box positions.";
+  } else if (startsWith(key, "pile-")) {
+    const std::string side = std::to_string(static_cast<int>(std::lround(std::cbrt(suffixInt(key, "pile-")))));
+    out.description = common + steps + ". A " + side + " x " + side + " x " + side +
+                      " grid of 1 m boxes (1 kg), 1.2 m apart, lowest layer at y = 1 m, dropped on the ground. The "
+                      "boxes fall, tumble and settle into a heap" + (side == "10" ? " about 5 m high" : "") +
+                      "; what is compared is cost per step and the heap's statistics, not box-by-box positions.";
     v = block("pile", ValidationKind::Statistics, Json::array({trace(top(), "height")}));
     v["top_body"] = top();
   } else if (key == "hinge-chain") {

@@ -42,6 +42,7 @@ struct RunFigures {
   int contacts_max = 0, islands_max = 0, contacts_final = 0;
   Real penetration_last_second = 0;
   Real last_second_from = 0;  // time at which the last second of the run starts
+  double stage_seconds[kStageCount] = {};  // summed over the run
 
   void record(const World& w) {
     const StepStats& st = w.lastStepStats();
@@ -50,6 +51,7 @@ struct RunFigures {
     islands_max = std::max(islands_max, st.islands);
     if (w.time() >= last_second_from - 1e-12) penetration_last_second = std::max(penetration_last_second, st.max_penetration);
     iterations += st.iterations;
+    for (int k = 0; k < kStageCount; ++k) stage_seconds[k] += st.stage_seconds[k];
     residual_final = st.residual;
     residual_max = std::max(residual_max, st.residual);
     rows_max = std::max(rows_max, st.rows);
@@ -81,6 +83,9 @@ struct RunFigures {
     m["contacts_final"] = contacts_final;
     m["islands_max"] = islands_max;
     m["penetration_last_second_max_m"] = penetration_last_second;
+    nlohmann::json stages = nlohmann::json::object();  // wall ms per step, by stage of the step
+    for (int k = 0; k < kStageCount; ++k) stages[stageName(static_cast<Stage>(k))] = 1e3 * stage_seconds[k] / steps;
+    m["stage_ms_per_step"] = stages;
   }
 };
 

@@ -9,19 +9,16 @@
 // one, and all do the same arithmetic per lane in the same order, so their
 // results are bit-identical (docs/performance.md, "Determinism").
 //
-// Per manifold only what the solver reads (Box2D v3's b2ContactConstraintSIMD
-// and Jolt's ContactConstraint keep the same): the two bodies, their inverse
-// masses and world inverse inertias (constant over the step), the normal,
-// and per point the anchors r_a, r_b (from each body's center of mass, world
-// frame), a tangent, the effective masses and the impulses. The Jacobian
-// and M^-1 J^T are formed on the fly from these: for a point with anchors
-// r_a, r_b and direction u,
+// Per manifold only what the solver reads, in the spirit of Box2D v3's
+// b2ContactConstraintSIMD and Bullet's btSolverConstraint: the two bodies,
+// their inverse masses and world inverse inertias (constant over the step),
+// the normal, and per point the angular parts of its rows' Jacobians (r_a x
+// u and r_b x u for the normal and the two tangents), the effective masses,
+// targets and impulses. M^-1 J^T is formed on the fly from the inverse
+// masses, which the kernel holds in registers for the whole manifold:
 //
-//   J v      = u . (v_b + w_b x r_b - v_a - w_a x r_a)
-//   dv_a     = -m_a^-1 u dl,   dw_a = -I_a^-1 (r_a x u) dl   (and + for b)
-//
-// which costs a few more flops than reading a stored J and M^-1 J^T but
-// streams a third of the bytes; the solve is bound by memory, not flops.
+//   J v   = u . (v_b - v_a) + (r_b x u) . w_b - (r_a x u) . w_a
+//   dv_a  = -m_a^-1 u dl,   dw_a = -I_a^-1 (r_a x u) dl   (and + for b)
 //
 // Normal rows of one manifold are solved together as a block (pgs.hpp
 // explains why): the block's matrix A_b = J_b M^-1 J_b^T + diag(cfm) and its
@@ -56,21 +53,23 @@ struct alignas(64) ContactBatch {
 
   struct Point {
     Lanes valid;            // 1 for a point in use, 0 for padding
-    Lanes ra[3], rb[3];     // anchors from the centers of mass, world
+    Lanes ran[3], rbn[3];   // r_a x n and r_b x n (anchors from the centers of mass, world)
     Lanes t[3];             // first tangent (the second is n x t)
+    Lanes rat[2][3], rbt[2][3];  // r_a x t_k and r_b x t_k
     Lanes rhs;              // velocity target of the normal row
-    Lanes bias;             // position-correction target (split impulse pass)
     Lanes normal_mass;      // 1 / (A_ii + cfm)
-    Lanes lambda;           // accumulated normal impulse (warm-started)
-    Lanes lambda_bias;      // the correction pass's impulse, from zero each step
-    Lanes max_lambda;       // the largest normal impulse of the step (restitution acts only where it was > 0)
-    Lanes bounce;           // restitution's target normal velocity (-e times the approach speed), 0: no bounce
     Lanes tangent_mass[2];  // 1 / (A_tt + cfm) for t and n x t
+    Lanes lambda;           // accumulated normal impulse (warm-started)
     Lanes lambda_t[2];      // accumulated friction impulses along t and n x t
+    Lanes max_lambda;       // the largest normal impulse of the step (restitution acts only where it was > 0)
     // NNCG (solver/pgs.hpp): this sweep's change of each impulse and the
     // momentum direction.
     Lanes change_n, change_t[2];
     Lanes dir_n, dir_t[2];
+    // The correction pass and restitution.
+    Lanes bias;             // position-correction target (split impulse pass)
+    Lanes lambda_bias;      // the correction pass's impulse, from zero each step
+    Lanes bounce;           // restitution's target normal velocity (-e times the approach speed), 0: no bounce
   } p[kMaxPoints];
 
   // The normal block: A_b (row-major lower triangle: 00, 10, 11, 20, 21, 22,

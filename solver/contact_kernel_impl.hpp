@@ -7,28 +7,36 @@
 // Nothing here may call a function shared with other translation units
 // (no Eigen, no std:: templates): an inline function compiled with AVX-512
 // in one unit and picked by the linker for another would break the
-// portable path on older CPUs. Only builtins and this file's own static
-// functions are used.
+// portable path on older CPUs. Only builtins, the compiler's intrinsics
+// (internal linkage) and this file's own static functions are used.
 //
 // Per lane the arithmetic is fixed and independent of W: masks freeze a
 // lane's iteration when it is done instead of letting its neighbours decide,
 // so W = 1, 4 and 8 give the same bits.
 //
-// Equations (contact_batch.hpp has the layout): for a point i with anchors
-// r_a, r_b, normal n and J v = n . dv, dv = (v_b + w_b x r_b) - (v_a + w_a x r_a):
+// Equations (contact_batch.hpp has the layout): a row along u at a point
+// with angular Jacobians -(r_a x u) and r_b x u has
+//   J v = u . (v_b - v_a) + (r_b x u) . w_b - (r_a x u) . w_a
+// and an impulse d along it changes
+//   v_a -= m_a^-1 u d,  w_a -= I_a^-1 (r_a x u) d,  v_b += m_b^-1 u d,  w_b += I_b^-1 (r_b x u) d.
 //
 //   normal block    A_b d = (rhs - J v) - cfm lambda, projected on lambda + d >= 0
 //                   (Cholesky factor L of A_b when every point pushes, else
-//                   projected Gauss-Seidel sweeps on A_b: pgs.hpp)
+//                   projected Gauss-Seidel sweeps on A_b: pgs.hpp); the
+//                   points' impulses, all along n, reach the bodies in one
+//                   update: v_a -= m_a^-1 n sum d_i, w_a -= I_a^-1 sum d_i (r_a x n)_i
 //   friction        per point, t then n x t, each a row:
-//                   l' = clamp(l + sor (-(t . dv) - cfm l) / (A_tt + cfm),
+//                   l' = clamp(l + sor (-J v - cfm l) / (A_tt + cfm),
 //                              -mu lambda_n, mu lambda_n)
-//   impulse P at r  v_a -= m_a^-1 P, w_a -= I_a^-1 (r_a x P); b gets +.
 #pragma once
 
 #include "solver/contact_kernels.hpp"
 
 #include <cstdint>
+
+#if defined(__AVX512F__) || defined(__AVX2__)
+#include <immintrin.h>
+#endif
 
 namespace cairn {
 namespace CAIRN_KERNEL_NS {
@@ -48,6 +56,8 @@ template <> struct VecTypes<8> {
   typedef long long M __attribute__((vector_size(64)));
 };
 
+#define CAIRN_INLINE static inline __attribute__((always_inline))
+
 template <int W>
 struct Kernel {
   using D = typename VecTypes<W>::D;
@@ -61,19 +71,25 @@ struct Kernel {
     D xx, yy, zz, xy, xz, yz;
   };
 
-  static inline __attribute__((always_inline)) D ld(const double* p) {
-    D r = {};
+  CAIRN_INLINE D ld(const double* p) {
+    D r;
     __builtin_memcpy(&r, p, sizeof r);
     return r;
   }
-  static inline __attribute__((always_inline)) void st(double* p, D v) { __builtin_memcpy(p, &v, sizeof v); }
-  static inline __attribute__((always_inline)) D splat(double x) {
+  CAIRN_INLINE void st(double* p, D v) { __builtin_memcpy(p, &v, sizeof v); }
+  CAIRN_INLINE D splat(double x) {
     D r = {};
     return r + x;
   }
-  static inline __attribute__((always_inline)) D vmax(D a, D b) { return a > b ? a : b; }
-  static inline __attribute__((always_inline)) D vabs(D a) { return a < 0 ? -a : a; }
-  static inline __attribute__((always_inline)) D sel(M m, D a, D b) { return m ? a : b; }
+  CAIRN_INLINE D zero() { return D{}; }
+  CAIRN_INLINE D vmax(D a, D b) { return a > b ? a : b; }
+  CAIRN_INLINE D vmin(D a, D b) { return a < b ? a : b; }
+  CAIRN_INLINE D vabs(D a) { return a < 0 ? -a : a; }
+  CAIRN_INLINE D sel(M m, D a, D b) { return m ? a : b; }
+  CAIRN_INLINE M allTrue() {
+    const D one = splat(1);
+    return one > 0;
+  }
   static inline bool any(M m) {
     for (int i = 0; i < W; ++i)
       if (m[i]) return true;
@@ -84,86 +100,129 @@ struct Kernel {
       if (!m[i]) return false;
     return true;
   }
-  static inline double hmax(D a) {
-    double r = a[0];
-    for (int i = 1; i < W; ++i) r = a[i] > r ? a[i] : r;
-    return r;
-  }
 
-  static inline __attribute__((always_inline)) V3 ld3(const double (*p)[kBatchLanes], int o) {
-    return V3{ld(p[0] + o), ld(p[1] + o), ld(p[2] + o)};
-  }
-  static inline __attribute__((always_inline)) void st3(double (*p)[kBatchLanes], int o, const V3& v) {
-    st(p[0] + o, v.x);
-    st(p[1] + o, v.y);
-    st(p[2] + o, v.z);
-  }
-  static inline __attribute__((always_inline)) S3 lds(const double (*p)[kBatchLanes], int o) {
+  CAIRN_INLINE V3 ld3(const double (*p)[kBatchLanes], int o) { return V3{ld(p[0] + o), ld(p[1] + o), ld(p[2] + o)}; }
+  CAIRN_INLINE S3 lds(const double (*p)[kBatchLanes], int o) {
     return S3{ld(p[0] + o), ld(p[1] + o), ld(p[2] + o), ld(p[3] + o), ld(p[4] + o), ld(p[5] + o)};
   }
-  static inline __attribute__((always_inline)) V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-  static inline __attribute__((always_inline)) V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-  static inline __attribute__((always_inline)) V3 mul(const V3& a, D s) { return {a.x * s, a.y * s, a.z * s}; }
-  static inline __attribute__((always_inline)) V3 cmul(const V3& a, const V3& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-  static inline __attribute__((always_inline)) D dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-  static inline __attribute__((always_inline)) V3 cross(const V3& a, const V3& b) {
+  CAIRN_INLINE V3 add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  CAIRN_INLINE V3 sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  CAIRN_INLINE V3 mul(const V3& a, D s) { return {a.x * s, a.y * s, a.z * s}; }
+  CAIRN_INLINE V3 cmul(const V3& a, const V3& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+  CAIRN_INLINE D dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+  CAIRN_INLINE V3 cross(const V3& a, const V3& b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
   }
-  static inline __attribute__((always_inline)) V3 mulS(const S3& m, const V3& v) {
+  CAIRN_INLINE V3 mulS(const S3& m, const V3& v) {
     return {m.xx * v.x + m.xy * v.y + m.xz * v.z, m.xy * v.x + m.yy * v.y + m.yz * v.z,
             m.xz * v.x + m.yz * v.y + m.zz * v.z};
   }
+  CAIRN_INLINE V3 zero3() { return V3{zero(), zero(), zero()}; }
 
-  // The two bodies of W lanes.
+  // The two bodies of W lanes: their velocities, and their mass data.
   struct Pair {
     V3 va, wa, vb, wb;
   };
+  struct Mass {
+    V3 ma, mb;
+    S3 ia, ib;
+  };
+  CAIRN_INLINE Mass loadMass(const ContactBatch& b, int o) {
+    return Mass{ld3(b.ma, o), ld3(b.mb, o), lds(b.ia, o), lds(b.ib, o)};
+  }
 
-  static inline void gather(const double* bodies, const std::int32_t* ia, const std::int32_t* ib, Pair& s) {
-    s = Pair{};
+  // --- Gathering and scattering the bodies' velocities. A body is 8
+  // doubles (v, w, two spare); for W bodies the kernel needs the six
+  // velocity components as six vectors: a transpose.
+  CAIRN_INLINE void gather1(const double* bodies, const std::int32_t* idx, V3& v, V3& w) {
+#if defined(__AVX512F__)
+    if constexpr (W == 8) {
+      __m512d r[8];
+      for (int i = 0; i < 8; ++i) r[i] = _mm512_loadu_pd(bodies + 8 * static_cast<long>(idx[i]));
+      // 8 x 8 transpose in three stages of two-lane, four-lane and 128-bit shuffles.
+      const __m512d t0 = _mm512_unpacklo_pd(r[0], r[1]), t1 = _mm512_unpackhi_pd(r[0], r[1]);
+      const __m512d t2 = _mm512_unpacklo_pd(r[2], r[3]), t3 = _mm512_unpackhi_pd(r[2], r[3]);
+      const __m512d t4 = _mm512_unpacklo_pd(r[4], r[5]), t5 = _mm512_unpackhi_pd(r[4], r[5]);
+      const __m512d t6 = _mm512_unpacklo_pd(r[6], r[7]), t7 = _mm512_unpackhi_pd(r[6], r[7]);
+      const __m512i lo = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0), hi = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
+      const __m512d u0 = _mm512_permutex2var_pd(t0, lo, t2), u1 = _mm512_permutex2var_pd(t1, lo, t3);
+      const __m512d u2 = _mm512_permutex2var_pd(t0, hi, t2), u3 = _mm512_permutex2var_pd(t1, hi, t3);
+      const __m512d u4 = _mm512_permutex2var_pd(t4, lo, t6), u5 = _mm512_permutex2var_pd(t5, lo, t7);
+      const __m512d u6 = _mm512_permutex2var_pd(t4, hi, t6), u7 = _mm512_permutex2var_pd(t5, hi, t7);
+      const __m512i a = _mm512_set_epi64(11, 10, 9, 8, 3, 2, 1, 0), c = _mm512_set_epi64(15, 14, 13, 12, 7, 6, 5, 4);
+      // Column k holds component k of the eight bodies.
+      const __m512d c0 = _mm512_permutex2var_pd(u0, a, u4), c1 = _mm512_permutex2var_pd(u1, a, u5);
+      const __m512d c2 = _mm512_permutex2var_pd(u2, a, u6), c3 = _mm512_permutex2var_pd(u3, a, u7);
+      const __m512d c4 = _mm512_permutex2var_pd(u0, c, u4), c5 = _mm512_permutex2var_pd(u1, c, u5);
+      __builtin_memcpy(&v.x, &c0, 64);
+      __builtin_memcpy(&v.y, &c1, 64);
+      __builtin_memcpy(&v.z, &c2, 64);
+      __builtin_memcpy(&w.x, &c3, 64);
+      __builtin_memcpy(&w.y, &c4, 64);
+      __builtin_memcpy(&w.z, &c5, 64);
+      return;
+    }
+#endif
+#if defined(__AVX2__)
+    if constexpr (W == 4) {
+      __m256d lo[4], hi[4];
+      for (int i = 0; i < 4; ++i) {
+        const double* p = bodies + 8 * static_cast<long>(idx[i]);
+        lo[i] = _mm256_loadu_pd(p);      // vx vy vz wx
+        hi[i] = _mm256_loadu_pd(p + 4);  // wy wz s s
+      }
+      const __m256d a0 = _mm256_unpacklo_pd(lo[0], lo[1]), a1 = _mm256_unpackhi_pd(lo[0], lo[1]);
+      const __m256d a2 = _mm256_unpacklo_pd(lo[2], lo[3]), a3 = _mm256_unpackhi_pd(lo[2], lo[3]);
+      const __m256d c0 = _mm256_permute2f128_pd(a0, a2, 0x20), c1 = _mm256_permute2f128_pd(a1, a3, 0x20);
+      const __m256d c2 = _mm256_permute2f128_pd(a0, a2, 0x31), c3 = _mm256_permute2f128_pd(a1, a3, 0x31);
+      const __m256d b0 = _mm256_unpacklo_pd(hi[0], hi[1]), b1 = _mm256_unpackhi_pd(hi[0], hi[1]);
+      const __m256d b2 = _mm256_unpacklo_pd(hi[2], hi[3]), b3 = _mm256_unpackhi_pd(hi[2], hi[3]);
+      const __m256d c4 = _mm256_permute2f128_pd(b0, b2, 0x20), c5 = _mm256_permute2f128_pd(b1, b3, 0x20);
+      __builtin_memcpy(&v.x, &c0, 32);
+      __builtin_memcpy(&v.y, &c1, 32);
+      __builtin_memcpy(&v.z, &c2, 32);
+      __builtin_memcpy(&w.x, &c3, 32);
+      __builtin_memcpy(&w.y, &c4, 32);
+      __builtin_memcpy(&w.z, &c5, 32);
+      return;
+    }
+#endif
     for (int i = 0; i < W; ++i) {
-      const double* a = bodies + 8 * static_cast<long>(ia[i]);
-      const double* b = bodies + 8 * static_cast<long>(ib[i]);
-      s.va.x[i] = a[0];
-      s.va.y[i] = a[1];
-      s.va.z[i] = a[2];
-      s.wa.x[i] = a[3];
-      s.wa.y[i] = a[4];
-      s.wa.z[i] = a[5];
-      s.vb.x[i] = b[0];
-      s.vb.y[i] = b[1];
-      s.vb.z[i] = b[2];
-      s.wb.x[i] = b[3];
-      s.wb.y[i] = b[4];
-      s.wb.z[i] = b[5];
+      const double* p = bodies + 8 * static_cast<long>(idx[i]);
+      v.x[i] = p[0];
+      v.y[i] = p[1];
+      v.z[i] = p[2];
+      w.x[i] = p[3];
+      w.y[i] = p[4];
+      w.z[i] = p[5];
     }
   }
 
-  // Writes back only dynamic bodies: static and kinematic ones are read
-  // only, so nothing (not even a NaN) reaches another island through them.
-  static inline void scatter(double* bodies, const std::int32_t* ia, const std::int32_t* ib, const Pair& s,
-                             int dynamic_end, M active) {
+  CAIRN_INLINE void gather(const double* bodies, const ContactBatch& b, int o, Pair& s) {
+    gather1(bodies, b.body_a + o, s.va, s.wa);
+    gather1(bodies, b.body_b + o, s.vb, s.wb);
+  }
+
+  // Writes back only dynamic bodies of the lanes in `write`: static and
+  // kinematic ones are read only, so nothing (not even a NaN) reaches
+  // another island through them.
+  CAIRN_INLINE void scatter1(double* bodies, const std::int32_t* idx, const V3& v, const V3& w, int dynamic_end,
+                             M write) {
     for (int i = 0; i < W; ++i) {
-      if (!active[i]) continue;
-      if (ia[i] > 0 && ia[i] < dynamic_end) {
-        double* a = bodies + 8 * static_cast<long>(ia[i]);
-        a[0] = s.va.x[i];
-        a[1] = s.va.y[i];
-        a[2] = s.va.z[i];
-        a[3] = s.wa.x[i];
-        a[4] = s.wa.y[i];
-        a[5] = s.wa.z[i];
-      }
-      if (ib[i] > 0 && ib[i] < dynamic_end) {
-        double* b = bodies + 8 * static_cast<long>(ib[i]);
-        b[0] = s.vb.x[i];
-        b[1] = s.vb.y[i];
-        b[2] = s.vb.z[i];
-        b[3] = s.wb.x[i];
-        b[4] = s.wb.y[i];
-        b[5] = s.wb.z[i];
-      }
+      if (!write[i] || idx[i] <= 0 || idx[i] >= dynamic_end) continue;
+      double* p = bodies + 8 * static_cast<long>(idx[i]);
+      p[0] = v.x[i];
+      p[1] = v.y[i];
+      p[2] = v.z[i];
+      p[3] = w.x[i];
+      p[4] = w.y[i];
+      p[5] = w.z[i];
     }
+  }
+
+  CAIRN_INLINE void scatter(double* bodies, const ContactBatch& b, int o, const Pair& s, int dynamic_end, M write) {
+    scatter1(bodies, b.body_a + o, s.va, s.wa, dynamic_end, write);
+    scatter1(bodies, b.body_b + o, s.vb, s.wb, dynamic_end, write);
   }
 
   // Lanes whose island still sweeps (all, without island_active).
@@ -173,92 +232,103 @@ struct Kernel {
       for (int i = 0; i < W; ++i) a[i] = island_active[b.island[o + i]];
     return a > 0;
   }
-  static inline M allLanes() {
-    const D one = splat(1);
-    return one > 0;
-  }
-
   static inline bool lanesEmpty(const ContactBatch& b, int o) {
     for (int i = 0; i < W; ++i)
       if (b.count[o + i] > 0) return false;
     return true;
   }
-  static inline bool pointEmpty(const ContactBatch& b, int o, int point) {
-    for (int i = 0; i < W; ++i)
-      if (b.count[o + i] > point) return false;
-    return true;
+  static inline int maxPoints(const ContactBatch& b, int o) {
+    int n = 0;
+    for (int i = 0; i < W; ++i) n = b.count[o + i] > n ? b.count[o + i] : n;
+    return n;
   }
 
-  // Relative velocity of the point: (v_b + w_b x r_b) - (v_a + w_a x r_a).
-  static inline __attribute__((always_inline)) V3 relVel(const Pair& s, const V3& ra, const V3& rb) {
-    return sub(add(s.vb, cross(s.wb, rb)), add(s.va, cross(s.wa, ra)));
+  // J v of a row with linear direction u and angular parts (ra_u, rb_u).
+  CAIRN_INLINE D rowVel(const Pair& s, const V3& u, const V3& ra_u, const V3& rb_u) {
+    return dot(u, sub(s.vb, s.va)) + dot(rb_u, s.wb) - dot(ra_u, s.wa);
   }
 
-  // Applies impulse P at (ra, rb): a gets -P, b gets +P.
-  static inline __attribute__((always_inline)) void applyAt(Pair& s, const V3& ma, const S3& ia, const V3& mb,
-                                                            const S3& ib, const V3& ra, const V3& rb, const V3& p) {
-    s.va = sub(s.va, cmul(ma, p));
-    s.wa = sub(s.wa, mulS(ia, cross(ra, p)));
-    s.vb = add(s.vb, cmul(mb, p));
-    s.wb = add(s.wb, mulS(ib, cross(rb, p)));
+  // An impulse along a row: linear part u d, angular parts (ra_u d, rb_u d).
+  CAIRN_INLINE void applyRow(Pair& s, const Mass& m, const V3& u, const V3& ra_u, const V3& rb_u, D d) {
+    const V3 p = mul(u, d);
+    s.va = sub(s.va, cmul(m.ma, p));
+    s.vb = add(s.vb, cmul(m.mb, p));
+    s.wa = sub(s.wa, mulS(m.ia, mul(ra_u, d)));
+    s.wb = add(s.wb, mulS(m.ib, mul(rb_u, d)));
   }
 
-  static inline int tri(int i, int j) { return i * (i + 1) / 2 + j; }  // i >= j
+  // Accumulated impulses of several rows, applied at once: linear sum P
+  // and angular sums (Ta, Tb), each the sum of d times the row's parts.
+  struct Sum {
+    V3 p, ta, tb;
+  };
+  CAIRN_INLINE void addRow(Sum& sum, const V3& u, const V3& ra_u, const V3& rb_u, D d) {
+    sum.p = add(sum.p, mul(u, d));
+    sum.ta = add(sum.ta, mul(ra_u, d));
+    sum.tb = add(sum.tb, mul(rb_u, d));
+  }
+  CAIRN_INLINE void applySum(Pair& s, const Mass& m, const Sum& sum) {
+    s.va = sub(s.va, cmul(m.ma, sum.p));
+    s.vb = add(s.vb, cmul(m.mb, sum.p));
+    s.wa = sub(s.wa, mulS(m.ia, sum.ta));
+    s.wb = add(s.wb, mulS(m.ib, sum.tb));
+  }
+
+  static constexpr int kBlockSweeps = 32;
+  static constexpr int tri(int i, int j) { return i * (i + 1) / 2 + j; }  // i >= j
+  static constexpr int sym(int i, int k) { return i >= k ? tri(i, k) : tri(k, i); }
 
   // The block solve of one manifold's normal rows toward targets `res`
   // (velocity errors, target - J v) from impulses `lam`; returns the
   // changes `dd` and leaves lam + dd in `lam`. `valid` masks real points.
-  static inline void solveBlock(const ContactBatch& b, int o, const D* res, D* lam, const D* valid, D cfm, D sor,
+  CAIRN_INLINE void solveBlock(const ContactBatch& b, int o, const D* res, D* lam, const D* valid, D cfm, D sor,
                                 const D* inv_diag, D* dd) {
-    D scale = splat(0);
+    D scale = zero();
     for (int i = 0; i < kMaxPoints; ++i) scale = vmax(scale, vabs(res[i]));
     const D tol = scale * 1e-6;
 
-    D l[10], a[10];
-    for (int k = 0; k < 10; ++k) {
-      l[k] = ld(b.factor[k] + o);
-      a[k] = ld(b.block[k] + o);
-    }
     // Every point pushing: forward and back substitution with L.
     D y[4], d[4];
     for (int i = 0; i < 4; ++i) {
       D sum = res[i] - cfm * lam[i];
-      for (int k = 0; k < i; ++k) sum -= l[tri(i, k)] * y[k];
-      y[i] = sum / l[tri(i, i)];
+      for (int k = 0; k < i; ++k) sum -= ld(b.factor[tri(i, k)] + o) * y[k];
+      y[i] = sum / ld(b.factor[tri(i, i)] + o);
     }
-    M accept = lam[0] == lam[0];  // all true
+    M accept = allTrue();
     for (int i = 3; i >= 0; --i) {
       D sum = y[i];
-      for (int k = i + 1; k < 4; ++k) sum -= l[tri(k, i)] * d[k];
-      d[i] = sum / l[tri(i, i)];
+      for (int k = i + 1; k < 4; ++k) sum -= ld(b.factor[tri(k, i)] + o) * d[k];
+      d[i] = sum / ld(b.factor[tri(i, i)] + o);
       accept &= (lam[i] + d[i] >= 0);
     }
     // The velocity errors left with the true A_b (the factor carries a
     // 1e-12 regularisation for singular face blocks).
+    D a[10];
+    for (int k = 0; k < 10; ++k) a[k] = ld(b.block[k] + o);
     for (int i = 0; i < 4; ++i) {
       D w = res[i] - cfm * (lam[i] + d[i]);
-      for (int k = 0; k < 4; ++k) w -= a[i >= k ? tri(i, k) : tri(k, i)] * d[k];
+      for (int k = 0; k < 4; ++k) w -= a[sym(i, k)] * d[k];
       accept &= (vabs(w) <= tol);
     }
     for (int i = 0; i < 4; ++i) {
-      const D next = vmax(lam[i] + sor * d[i], splat(0));
-      dd[i] = sel(accept, next - lam[i], splat(0));
+      const D next = vmax(lam[i] + sor * d[i], zero());
+      dd[i] = sel(accept, next - lam[i], zero());
     }
     if (!all(accept)) {
       // Projected sweeps on A_b for the lanes whose points do not all push,
       // each lane until its own velocity errors are below tol (at most 32).
-      D fd[4] = {splat(0), splat(0), splat(0), splat(0)};
+      D fd[4] = {zero(), zero(), zero(), zero()};
       D fl[4] = {lam[0], lam[1], lam[2], lam[3]};
       M done = accept;
-      for (int sweep = 0; sweep < 32; ++sweep) {
-        D worst = splat(0);
+      for (int sweep = 0; sweep < kBlockSweeps; ++sweep) {
+        D worst = zero();
         for (int i = 0; i < 4; ++i) {
-          D jv = splat(0);
-          for (int k = 0; k < 4; ++k) jv += a[i >= k ? tri(i, k) : tri(k, i)] * fd[k];
+          D jv = zero();
+          for (int k = 0; k < 4; ++k) jv += a[sym(i, k)] * fd[k];
           const D w = (res[i] - jv - cfm * fl[i]) * valid[i];
           const M counts = (w > 0) | (fl[i] > 0);
-          worst = vmax(worst, sel(counts, vabs(w), splat(0)));
-          const D next = vmax(fl[i] + sor * w * inv_diag[i], splat(0));
+          worst = vmax(worst, sel(counts, vabs(w), zero()));
+          const D next = vmax(fl[i] + sor * w * inv_diag[i], zero());
           fd[i] = sel(done, fd[i], fd[i] + (next - fl[i]));
           fl[i] = sel(done, fl[i], next);
         }
@@ -276,22 +346,26 @@ struct Kernel {
       for (int o = 0; o < kBatchLanes; o += W) {
         if (lanesEmpty(b, o)) continue;
         Pair s;
-        gather(bodies, b.body_a + o, b.body_b + o, s);
-        const V3 n = ld3(b.n, o), ma = ld3(b.ma, o), mb = ld3(b.mb, o);
-        const S3 ia = lds(b.ia, o), ib = lds(b.ib, o);
-        for (int i = 0; i < kMaxPoints; ++i) {
-          if (pointEmpty(b, o, i)) break;
+        gather(bodies, b, o, s);
+        const Mass m = loadMass(b, o);
+        const V3 n = ld3(b.n, o);
+        Sum sum{zero3(), zero3(), zero3()};
+        const int points = maxPoints(b, o);
+        for (int i = 0; i < points; ++i) {
           const ContactBatch::Point& q = b.p[i];
-          const V3 t1 = ld3(q.t, o), t2 = cross(n, t1);
-          const V3 imp = add(mul(n, ld(q.lambda + o)), add(mul(t1, ld(q.lambda_t[0] + o)), mul(t2, ld(q.lambda_t[1] + o))));
-          applyAt(s, ma, ia, mb, ib, ld3(q.ra, o), ld3(q.rb, o), imp);
+          addRow(sum, n, ld3(q.ran, o), ld3(q.rbn, o), ld(q.lambda + o));
+          const V3 t1 = ld3(q.t, o);
+          addRow(sum, t1, ld3(q.rat[0], o), ld3(q.rbt[0], o), ld(q.lambda_t[0] + o));
+          addRow(sum, cross(n, t1), ld3(q.rat[1], o), ld3(q.rbt[1], o), ld(q.lambda_t[1] + o));
         }
-        scatter(bodies, b.body_a + o, b.body_b + o, s, p.dynamic_end, allLanes());
+        applySum(s, m, sum);
+        scatter(bodies, b, o, s, p.dynamic_end, allTrue());
       }
     }
   }
 
-  static void solve(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p) {
+  // One projected Gauss-Seidel visit of every manifold's normal block.
+  static void solveNormals(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p) {
     const D sor = splat(p.sor);
     for (int bi = begin; bi < end; ++bi) {
       ContactBatch& b = batches[bi];
@@ -299,34 +373,33 @@ struct Kernel {
         if (lanesEmpty(b, o)) continue;
         const M active = activeLanes(b, o, p.island_active);
         if (!any(active)) continue;
-        D maxd = splat(0), maxl = splat(0);
         Pair s;
-        gather(bodies, b.body_a + o, b.body_b + o, s);
-        const V3 n = ld3(b.n, o), ma = ld3(b.ma, o), mb = ld3(b.mb, o);
-        const S3 ia = lds(b.ia, o), ib = lds(b.ib, o);
+        gather(bodies, b, o, s);
+        const Mass m = loadMass(b, o);
+        const V3 n = ld3(b.n, o);
         const D cfm = ld(b.cfm + o);
-
-        // Normal block.
+        D maxd = zero(), maxl = zero(), ch2 = zero();
         D res[4], lam[4], valid[4], inv_diag[4], dd[4];
+        const V3 dv = sub(s.vb, s.va);
+        const D n_dv = dot(n, dv);
         for (int i = 0; i < 4; ++i) {
           const ContactBatch::Point& q = b.p[i];
           valid[i] = ld(q.valid + o);
           lam[i] = ld(q.lambda + o);
           inv_diag[i] = ld(q.normal_mass + o);
-          const V3 dv = relVel(s, ld3(q.ra, o), ld3(q.rb, o));
-          res[i] = (ld(q.rhs + o) - dot(n, dv)) * valid[i];
+          const D jv = n_dv + dot(ld3(q.rbn, o), s.wb) - dot(ld3(q.ran, o), s.wa);
+          res[i] = (ld(q.rhs + o) - jv) * valid[i];
         }
         solveBlock(b, o, res, lam, valid, cfm, sor, inv_diag, dd);
-        D sum = splat(0);
-        V3 ta{splat(0), splat(0), splat(0)}, tb = ta;
-        D ch2 = splat(0);
+        D total = zero();
+        V3 ta = zero3(), tb = zero3();
         for (int i = 0; i < 4; ++i) {
           ContactBatch::Point& q = b.p[i];
-          dd[i] = sel(active, dd[i], splat(0));
+          dd[i] = sel(active, dd[i], zero());
           lam[i] = sel(active, lam[i], ld(q.lambda + o));
-          sum += dd[i];
-          ta = add(ta, mul(ld3(q.ra, o), dd[i]));
-          tb = add(tb, mul(ld3(q.rb, o), dd[i]));
+          total += dd[i];
+          ta = add(ta, mul(ld3(q.ran, o), dd[i]));
+          tb = add(tb, mul(ld3(q.rbn, o), dd[i]));
           st(q.lambda + o, lam[i]);
           st(q.max_lambda + o, vmax(ld(q.max_lambda + o), lam[i]));
           maxd = vmax(maxd, vabs(dd[i]));
@@ -336,109 +409,120 @@ struct Kernel {
             ch2 += dd[i] * dd[i];
           }
         }
-        // Sum of the point impulses n dd_i: one update per body.
-        const V3 pn = mul(n, sum);
-        s.va = sub(s.va, cmul(ma, pn));
-        s.vb = add(s.vb, cmul(mb, pn));
-        s.wa = sub(s.wa, mulS(ia, cross(ta, n)));
-        s.wb = add(s.wb, mulS(ib, cross(tb, n)));
+        applySum(s, m, Sum{mul(n, total), ta, tb});
+        if (p.gather_change) st(b.change2 + o, ch2);
+        st(b.sweep_delta + o, maxd);
+        st(b.sweep_lambda + o, maxl);
+        scatter(bodies, b, o, s, p.dynamic_end, active);
+      }
+    }
+  }
 
-        // Friction per point: two tangent rows, t then n x t, each bounded by
-        // mu lambda_n of its point (the friction pyramid, as ODE and Bullet
-        // with two directions; t is along the sliding direction when
-        // sliding, so the pyramid's corners do not bias a sliding body).
+  // One projected Gauss-Seidel visit of every manifold's friction rows,
+  // after the normal pass of the same sweep: per point two tangent rows, t
+  // then n x t, each bounded by mu lambda_n of its point (the friction
+  // pyramid, as ODE and Bullet with two directions; t is along the sliding
+  // direction when sliding, so the pyramid's corners do not bias a sliding
+  // body). The lane's sweep figures grow from the normal pass's.
+  static void solveFriction(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p) {
+    const D sor = splat(p.sor);
+    for (int bi = begin; bi < end; ++bi) {
+      ContactBatch& b = batches[bi];
+      for (int o = 0; o < kBatchLanes; o += W) {
+        if (lanesEmpty(b, o)) continue;
         const D mu = ld(b.mu + o);
-        if (any(mu > 0)) {
-          for (int i = 0; i < kMaxPoints; ++i) {
-            if (pointEmpty(b, o, i)) break;
-            ContactBatch::Point& q = b.p[i];
-            const V3 ra = ld3(q.ra, o), rb = ld3(q.rb, o);
-            const V3 t1 = ld3(q.t, o);
-            const D limit = mu * lam[i];
-            for (int k = 0; k < 2; ++k) {
-              const V3 t = k == 0 ? t1 : cross(n, t1);
-              const D l = ld(q.lambda_t[k] + o);
-              const D jv = dot(t, relVel(s, ra, rb));
-              D next = l + sor * (-jv - cfm * l) * ld(q.tangent_mass[k] + o);
-              next = vmax(next, -limit);
-              next = next < limit ? next : limit;
-              next = sel(active, next, l);
-              const D d = next - l;
-              applyAt(s, ma, ia, mb, ib, ra, rb, mul(t, d));
-              st(q.lambda_t[k] + o, next);
-              maxd = vmax(maxd, vabs(d));
-              maxl = vmax(maxl, vabs(next));
-              if (p.gather_change) {
-                st(q.change_t[k] + o, d);
-                ch2 += d * d;
-              }
+        const M active = activeLanes(b, o, p.island_active) & (mu > 0);
+        if (!any(active)) continue;
+        Pair s;
+        gather(bodies, b, o, s);
+        const Mass m = loadMass(b, o);
+        const V3 n = ld3(b.n, o);
+        const D cfm = ld(b.cfm + o);
+        const int points = maxPoints(b, o);
+        D maxd = ld(b.sweep_delta + o), maxl = ld(b.sweep_lambda + o);
+        D ch2 = p.gather_change ? ld(b.change2 + o) : zero();
+        for (int i = 0; i < points; ++i) {
+          ContactBatch::Point& q = b.p[i];
+          const V3 t1 = ld3(q.t, o);
+          const D limit = mu * ld(q.lambda + o);
+          for (int k = 0; k < 2; ++k) {
+            const V3 u = k == 0 ? t1 : cross(n, t1);
+            const V3 ra_u = ld3(q.rat[k], o), rb_u = ld3(q.rbt[k], o);
+            const D l = ld(q.lambda_t[k] + o);
+            D next = l + sor * (-rowVel(s, u, ra_u, rb_u) - cfm * l) * ld(q.tangent_mass[k] + o);
+            next = vmin(vmax(next, -limit), limit);
+            next = sel(active, next, l);
+            const D d = next - l;
+            applyRow(s, m, u, ra_u, rb_u, d);
+            st(q.lambda_t[k] + o, next);
+            maxd = vmax(maxd, vabs(d));
+            maxl = vmax(maxl, vabs(next));
+            if (p.gather_change) {
+              st(q.change_t[k] + o, d);
+              ch2 += d * d;
             }
           }
         }
         if (p.gather_change) st(b.change2 + o, ch2);
         st(b.sweep_delta + o, maxd);
         st(b.sweep_lambda + o, maxl);
-        scatter(bodies, b.body_a + o, b.body_b + o, s, p.dynamic_end, active);
+        scatter(bodies, b, o, s, p.dynamic_end, active);
       }
     }
   }
 
+  // NNCG's momentum: lambda' = proj(lambda + beta p); the changes need no
+  // velocity, so they are summed and reach the bodies once per manifold.
   static void momentum(ContactBatch* batches, int begin, int end, double* bodies, const double* island_beta,
                        const ContactSweepParams& p) {
     for (int bi = begin; bi < end; ++bi) {
       ContactBatch& b = batches[bi];
       for (int o = 0; o < kBatchLanes; o += W) {
         if (lanesEmpty(b, o)) continue;
-        D beta = {};
+        D beta = zero();
         for (int i = 0; i < W; ++i) beta[i] = island_beta[b.island[o + i]];
         const M apply = (beta > 0) & (beta <= 1);
         const M reset_to_change = beta == 0;
         const M stopped = beta < 0;
-        const V3 n = ld3(b.n, o);
+        const int points = maxPoints(b, o);
+        const auto newDir = [&](D dir, D ch) { return sel(apply, beta * dir + ch, sel(stopped, dir, sel(reset_to_change, ch, zero()))); };
         if (!any(apply)) {
           // No step anywhere in these lanes: p = change (first sweep) or 0 (restart).
-          for (int i = 0; i < kMaxPoints; ++i) {
+          for (int i = 0; i < points; ++i) {
             ContactBatch::Point& q = b.p[i];
-            const D zero = splat(0);
-            st(q.dir_n + o, sel(stopped, ld(q.dir_n + o), sel(reset_to_change, ld(q.change_n + o), zero)));
-            st(q.dir_t[0] + o, sel(stopped, ld(q.dir_t[0] + o), sel(reset_to_change, ld(q.change_t[0] + o), zero)));
-            st(q.dir_t[1] + o, sel(stopped, ld(q.dir_t[1] + o), sel(reset_to_change, ld(q.change_t[1] + o), zero)));
+            st(q.dir_n + o, newDir(ld(q.dir_n + o), ld(q.change_n + o)));
+            st(q.dir_t[0] + o, newDir(ld(q.dir_t[0] + o), ld(q.change_t[0] + o)));
+            st(q.dir_t[1] + o, newDir(ld(q.dir_t[1] + o), ld(q.change_t[1] + o)));
           }
           continue;
         }
         Pair s;
-        gather(bodies, b.body_a + o, b.body_b + o, s);
-        const V3 ma = ld3(b.ma, o), mb = ld3(b.mb, o);
-        const S3 ia = lds(b.ia, o), ib = lds(b.ib, o);
+        gather(bodies, b, o, s);
+        const Mass m = loadMass(b, o);
+        const V3 n = ld3(b.n, o);
         const D mu = ld(b.mu + o);
-        const D bstep = sel(apply, beta, splat(0));
-        D lam[4];
-        for (int i = 0; i < kMaxPoints; ++i) {
+        const D bstep = sel(apply, beta, zero());
+        Sum sum{zero3(), zero3(), zero3()};
+        for (int i = 0; i < points; ++i) {
           ContactBatch::Point& q = b.p[i];
-          const D l = ld(q.lambda + o), dir = ld(q.dir_n + o), ch = ld(q.change_n + o);
-          const D next = sel(apply, vmax(l + bstep * dir, splat(0)), l);
-          const D d = next - l;
-          lam[i] = next;
-          st(q.lambda + o, next);
-          st(q.max_lambda + o, vmax(ld(q.max_lambda + o), next));
-          st(q.dir_n + o, sel(apply, beta * dir + ch, sel(stopped, dir, sel(reset_to_change, ch, splat(0)))));
-          applyAt(s, ma, ia, mb, ib, ld3(q.ra, o), ld3(q.rb, o), mul(n, d));
-        }
-        for (int i = 0; i < kMaxPoints; ++i) {
-          ContactBatch::Point& q = b.p[i];
-          const V3 ra = ld3(q.ra, o), rb = ld3(q.rb, o), t1 = ld3(q.t, o);
-          const D limit = mu * lam[i];
+          const D l = ld(q.lambda + o), dir = ld(q.dir_n + o);
+          const D ln = sel(apply, vmax(l + bstep * dir, zero()), l);
+          st(q.lambda + o, ln);
+          st(q.max_lambda + o, vmax(ld(q.max_lambda + o), ln));
+          st(q.dir_n + o, newDir(dir, ld(q.change_n + o)));
+          addRow(sum, n, ld3(q.ran, o), ld3(q.rbn, o), ln - l);
+          const V3 t1 = ld3(q.t, o);
+          const D limit = mu * ln;
           for (int k = 0; k < 2; ++k) {
-            const D l = ld(q.lambda_t[k] + o), dir = ld(q.dir_t[k] + o), ch = ld(q.change_t[k] + o);
-            D next = vmax(l + bstep * dir, -limit);
-            next = next < limit ? next : limit;
-            next = sel(apply, next, l);
+            const D lt = ld(q.lambda_t[k] + o), dt = ld(q.dir_t[k] + o);
+            const D next = sel(apply, vmin(vmax(lt + bstep * dt, -limit), limit), lt);
             st(q.lambda_t[k] + o, next);
-            st(q.dir_t[k] + o, sel(apply, beta * dir + ch, sel(stopped, dir, sel(reset_to_change, ch, splat(0)))));
-            applyAt(s, ma, ia, mb, ib, ra, rb, mul(k == 0 ? t1 : cross(n, t1), next - l));
+            st(q.dir_t[k] + o, newDir(dt, ld(q.change_t[k] + o)));
+            addRow(sum, k == 0 ? t1 : cross(n, t1), ld3(q.rat[k], o), ld3(q.rbt[k], o), next - lt);
           }
         }
-        scatter(bodies, b.body_a + o, b.body_b + o, s, p.dynamic_end, apply);
+        applySum(s, m, sum);
+        scatter(bodies, b, o, s, p.dynamic_end, apply);
       }
     }
   }
@@ -451,43 +535,39 @@ struct Kernel {
         if (lanesEmpty(b, o)) continue;
         const M active = activeLanes(b, o, p.island_active);
         if (!any(active)) continue;
-        D maxd = splat(0), maxl = splat(0);
         Pair s;
-        gather(pseudo, b.body_a + o, b.body_b + o, s);
-        const V3 n = ld3(b.n, o), ma = ld3(b.ma, o), mb = ld3(b.mb, o);
-        const S3 ia = lds(b.ia, o), ib = lds(b.ib, o);
+        gather(pseudo, b, o, s);
+        const Mass m = loadMass(b, o);
+        const V3 n = ld3(b.n, o);
         const D cfm = ld(b.cfm + o);
         D res[4], lam[4], valid[4], inv_diag[4], dd[4];
+        const D n_dv = dot(n, sub(s.vb, s.va));
         for (int i = 0; i < 4; ++i) {
           const ContactBatch::Point& q = b.p[i];
           valid[i] = ld(q.valid + o);
           lam[i] = ld(q.lambda_bias + o);
           inv_diag[i] = ld(q.normal_mass + o);
-          const V3 dv = relVel(s, ld3(q.ra, o), ld3(q.rb, o));
-          res[i] = (ld(q.bias + o) - dot(n, dv)) * valid[i];
+          const D jv = n_dv + dot(ld3(q.rbn, o), s.wb) - dot(ld3(q.ran, o), s.wa);
+          res[i] = (ld(q.bias + o) - jv) * valid[i];
         }
         solveBlock(b, o, res, lam, valid, cfm, sor, inv_diag, dd);
-        D sum = splat(0);
-        V3 ta{splat(0), splat(0), splat(0)}, tb = ta;
+        D total = zero(), maxd = zero(), maxl = zero();
+        V3 ta = zero3(), tb = zero3();
         for (int i = 0; i < 4; ++i) {
           ContactBatch::Point& q = b.p[i];
-          dd[i] = sel(active, dd[i], splat(0));
+          dd[i] = sel(active, dd[i], zero());
           lam[i] = sel(active, lam[i], ld(q.lambda_bias + o));
-          sum += dd[i];
-          ta = add(ta, mul(ld3(q.ra, o), dd[i]));
-          tb = add(tb, mul(ld3(q.rb, o), dd[i]));
+          total += dd[i];
+          ta = add(ta, mul(ld3(q.ran, o), dd[i]));
+          tb = add(tb, mul(ld3(q.rbn, o), dd[i]));
           st(q.lambda_bias + o, lam[i]);
           maxd = vmax(maxd, vabs(dd[i]));
           maxl = vmax(maxl, lam[i]);
         }
-        const V3 pn = mul(n, sum);
-        s.va = sub(s.va, cmul(ma, pn));
-        s.vb = add(s.vb, cmul(mb, pn));
-        s.wa = sub(s.wa, mulS(ia, cross(ta, n)));
-        s.wb = add(s.wb, mulS(ib, cross(tb, n)));
+        applySum(s, m, Sum{mul(n, total), ta, tb});
         st(b.sweep_delta + o, maxd);
         st(b.sweep_lambda + o, maxl);
-        scatter(pseudo, b.body_a + o, b.body_b + o, s, p.dynamic_end, active);
+        scatter(pseudo, b, o, s, p.dynamic_end, active);
       }
     }
   }
@@ -500,76 +580,75 @@ struct Kernel {
         if (lanesEmpty(b, o)) continue;
         // Points that bounce: a bounce target, and a normal impulse during the step.
         D bouncing[4];
-        M lane_bounces = splat(0) != splat(0);  // all false
+        M lane_bounces = zero() != zero();  // all false
         for (int i = 0; i < 4; ++i) {
           const ContactBatch::Point& q = b.p[i];
           const M m = (ld(q.bounce + o) != 0) & (ld(q.max_lambda + o) > 0) & (ld(q.valid + o) > 0);
-          bouncing[i] = sel(m, splat(1), splat(0));
+          bouncing[i] = sel(m, splat(1), zero());
           lane_bounces |= m;
         }
         if (!any(lane_bounces)) continue;
         Pair s;
-        gather(bodies, b.body_a + o, b.body_b + o, s);
-        const V3 n = ld3(b.n, o), ma = ld3(b.ma, o), mb = ld3(b.mb, o);
-        const S3 ia = lds(b.ia, o), ib = lds(b.ib, o);
+        gather(bodies, b, o, s);
+        const Mass m = loadMass(b, o);
+        const V3 n = ld3(b.n, o);
         const D cfm = ld(b.cfm + o);
         D res[4], lam[4], inv_diag[4], a[10];
         for (int k = 0; k < 10; ++k) a[k] = ld(b.block[k] + o);
-        D scale = splat(0);
+        D scale = zero();
+        const D n_dv = dot(n, sub(s.vb, s.va));
         for (int i = 0; i < 4; ++i) {
           const ContactBatch::Point& q = b.p[i];
           lam[i] = ld(q.lambda + o);
           inv_diag[i] = ld(q.normal_mass + o);
-          const V3 dv = relVel(s, ld3(q.ra, o), ld3(q.rb, o));
-          res[i] = (ld(q.bounce + o) - dot(n, dv)) * bouncing[i];
+          const D jv = n_dv + dot(ld3(q.rbn, o), s.wb) - dot(ld3(q.ran, o), s.wa);
+          res[i] = (ld(q.bounce + o) - jv) * bouncing[i];
           scale = vmax(scale, vabs(res[i]));
         }
         // Projected sweeps on the bouncing points' block, each lane until
         // its velocity errors fall below 1e-6 of the largest it began with.
         const D tol = scale * 1e-6;
-        D fd[4] = {splat(0), splat(0), splat(0), splat(0)};
-        M done = lane_bounces == 0;
+        D fd[4] = {zero(), zero(), zero(), zero()};
+        M done = ~lane_bounces;
         for (int sweep = 0; sweep < 32; ++sweep) {
-          D worst = splat(0);
+          D worst = zero();
           for (int i = 0; i < 4; ++i) {
-            D jv = splat(0);
-            for (int k = 0; k < 4; ++k) jv += a[i >= k ? tri(i, k) : tri(k, i)] * fd[k];
+            D jv = zero();
+            for (int k = 0; k < 4; ++k) jv += a[sym(i, k)] * fd[k];
             const D w = (res[i] - jv - cfm * lam[i]) * bouncing[i];
             const M counts = (w > 0) | (lam[i] > 0);
-            worst = vmax(worst, sel(counts, vabs(w), splat(0)));
-            const D next = vmax(lam[i] + sor * w * inv_diag[i], splat(0));
+            worst = vmax(worst, sel(counts, vabs(w), zero()));
+            const D next = vmax(lam[i] + sor * w * inv_diag[i], zero());
             fd[i] = sel(done, fd[i], fd[i] + (next - lam[i]));
             lam[i] = sel(done, lam[i], next);
           }
           done |= (worst <= tol);
           if (all(done)) break;
         }
-        D sum = splat(0);
-        V3 ta{splat(0), splat(0), splat(0)}, tb = ta;
+        D total = zero();
+        V3 ta = zero3(), tb = zero3();
         for (int i = 0; i < 4; ++i) {
           ContactBatch::Point& q = b.p[i];
-          sum += fd[i];
-          ta = add(ta, mul(ld3(q.ra, o), fd[i]));
-          tb = add(tb, mul(ld3(q.rb, o), fd[i]));
+          total += fd[i];
+          ta = add(ta, mul(ld3(q.ran, o), fd[i]));
+          tb = add(tb, mul(ld3(q.rbn, o), fd[i]));
           st(q.lambda + o, lam[i]);
         }
-        const V3 pn = mul(n, sum);
-        s.va = sub(s.va, cmul(ma, pn));
-        s.vb = add(s.vb, cmul(mb, pn));
-        s.wa = sub(s.wa, mulS(ia, cross(ta, n)));
-        s.wb = add(s.wb, mulS(ib, cross(tb, n)));
-        scatter(bodies, b.body_a + o, b.body_b + o, s, p.dynamic_end, lane_bounces);
+        applySum(s, m, Sum{mul(n, total), ta, tb});
+        scatter(bodies, b, o, s, p.dynamic_end, lane_bounces);
       }
     }
   }
 };
+
+#undef CAIRN_INLINE
 
 }  // namespace
 
 // The table of this unit's kernels.
 inline ContactKernels makeKernels(const char* name) {
   using K = Kernel<CAIRN_KERNEL_LANES>;
-  return ContactKernels{name, CAIRN_KERNEL_LANES, &K::warmStart, &K::solve, &K::momentum, &K::solveBias, &K::restitution};
+  return ContactKernels{name, CAIRN_KERNEL_LANES, &K::warmStart, &K::solveNormals, &K::solveFriction, &K::momentum, &K::solveBias, &K::restitution};
 }
 
 }  // namespace CAIRN_KERNEL_NS

@@ -24,11 +24,14 @@ struct ContactKernels {
   int lanes;  // doubles per vector
   // Adds M^-1 J^T lambda of the carried impulses (normal and friction).
   void (*warm_start)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
-  // One projected Gauss-Seidel visit of every manifold: the normal block,
-  // then the two friction rows of each point.
-  // Each lane records its largest change and impulse in sweep_delta and
-  // sweep_lambda (and, with gather_change, NNCG's changes).
-  void (*solve)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
+  // One projected Gauss-Seidel visit of every manifold's normal block, and
+  // (a second pass, after every colour's normals) of its friction rows,
+  // bounded by the normal impulses of the same sweep, as Bullet's
+  // btSequentialImpulseConstraintSolver orders them. Each lane records its
+  // largest change and impulse in sweep_delta and sweep_lambda (and, with
+  // gather_change, NNCG's changes); the friction pass adds to them.
+  void (*solve_normals)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
+  void (*solve_friction)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
   // NNCG's momentum step (pgs.hpp): lambda += beta p projected on the
   // bounds, with beta per island (beta == 0: p = this sweep's change, no
   // step; beta > 1: restart, p = 0; beta < 0: the island has stopped,

@@ -5,9 +5,13 @@ namespace cairn {
 namespace {
 thread_local int t_thread_index = 0;
 
-// Spins this many times on an atomic before blocking on it: a loop of the
-// step usually arrives within a few microseconds of the last one.
-constexpr int kSpins = 4000;
+// Spins this many times on an atomic before yielding, and yields this many
+// times before blocking on it: a loop of the step usually arrives within a
+// few microseconds of the last one, and when the machine has fewer free
+// cores than threads a yielding waiter hands its core to the thread it
+// waits for instead of spinning out its time slice.
+constexpr int kSpins = 256;
+constexpr int kYields = 64;
 
 inline void pause() {
 #if defined(__x86_64__) || defined(__i386__)
@@ -22,9 +26,12 @@ WorkerPool::WorkerPool(int threads) : threads_(threads < 1 ? 1 : threads) {
 }
 
 WorkerPool::~WorkerPool() {
-  stop_.store(true, std::memory_order_release);
-  generation_.fetch_add(1, std::memory_order_acq_rel);
-  generation_.notify_all();
+  {
+    const std::lock_guard<std::mutex> lock(wake_mutex_);
+    stop_.store(true, std::memory_order_release);
+    generation_.fetch_add(1, std::memory_order_acq_rel);
+  }
+  wake_.notify_all();
   for (auto& t : workers_) t.join();
 }
 
@@ -42,8 +49,13 @@ void WorkerPool::run(const Job& job) {
   // Every worker reports back, busy or not, so none still reads job_ when
   // the next loop overwrites it.
   remaining_.store(threads_ - 1, std::memory_order_relaxed);
-  generation_.fetch_add(1, std::memory_order_acq_rel);
-  generation_.notify_all();
+  {
+    // Under the mutex, so a worker between its last look and its sleep
+    // cannot miss the new generation.
+    const std::lock_guard<std::mutex> lock(wake_mutex_);
+    generation_.fetch_add(1, std::memory_order_acq_rel);
+  }
+  wake_.notify_all();
   doChunk(job_, 0);
   for (int spin = 0; remaining_.load(std::memory_order_acquire) != 0; ++spin) {
     if (spin < kSpins) pause();
@@ -53,15 +65,19 @@ void WorkerPool::run(const Job& job) {
 
 void WorkerPool::workerLoop(int index) {
   t_thread_index = index;
-  std::uint64_t seen = generation_.load(std::memory_order_acquire);
+  // The generation at construction, not at this thread's start: a job
+  // posted before the thread first runs must still be seen as new.
+  std::uint64_t seen = 0;
   for (;;) {
     std::uint64_t now = generation_.load(std::memory_order_acquire);
-    for (int spin = 0; now == seen && spin < kSpins; ++spin) {
-      pause();
+    for (int spin = 0; now == seen && spin < kSpins + kYields; ++spin) {
+      if (spin < kSpins) pause();
+      else std::this_thread::yield();
       now = generation_.load(std::memory_order_acquire);
     }
     if (now == seen) {
-      generation_.wait(seen, std::memory_order_acquire);
+      std::unique_lock<std::mutex> lock(wake_mutex_);
+      wake_.wait(lock, [&] { return generation_.load(std::memory_order_acquire) != seen; });
       continue;
     }
     seen = now;

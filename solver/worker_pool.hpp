@@ -15,7 +15,9 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
+#include <mutex>
 #include <thread>
 #include <type_traits>
 #include <vector>
@@ -67,7 +69,12 @@ class WorkerPool {
   int threads_;
   std::vector<std::thread> workers_;
   Job job_;
+  // A new job bumps generation_; idle workers spin, yield, then sleep on
+  // wake_, whose mutex orders the bump against a worker's last look before
+  // sleeping, so no job is missed.
   std::atomic<std::uint64_t> generation_{0};
+  std::mutex wake_mutex_;
+  std::condition_variable wake_;
   std::atomic<int> remaining_{0};
   std::atomic<bool> stop_{false};
 };

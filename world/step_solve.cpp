@@ -43,6 +43,20 @@ void writeBack(WorldImpl& w, StepContext& ctx) {
   }
 }
 
+// A manifold lane's row: direction u, angular parts (ra x u, rb x u).
+struct LaneRow {
+  Vec3 u, ra_u, rb_u;
+};
+
+LaneRow laneRowParts(const ContactBatch& b, int l, int i, int row) {  // row 0: normal, 1, 2: tangents
+  const ContactBatch::Point& q = b.p[i];
+  const auto v3 = [&](const double (*f)[kBatchLanes]) { return Vec3(f[0][l], f[1][l], f[2][l]); };
+  const Vec3 n = v3(b.n);
+  if (row == 0) return {n, v3(q.ran), v3(q.rbn)};
+  const Vec3 t1 = v3(q.t);
+  return {row == 1 ? t1 : Vec3(n.cross(t1)), v3(q.rat[row - 1]), v3(q.rbt[row - 1])};
+}
+
 // The natural-map residual of the manifolds (solver/lcp_residual.hpp's
 // definition, with the velocities after the solve): per row
 // |lambda - clamp(lambda - w, lo, hi)|, w = J v - rhs + cfm lambda.
@@ -53,23 +67,19 @@ Real manifoldResidual(const GraphProblem& g, std::span<const SolverBody> v) {
       if (b.count[l] == 0) continue;
       const SolverBody& a = v[static_cast<size_t>(b.body_a[l])];
       const SolverBody& c = v[static_cast<size_t>(b.body_b[l])];
-      const Vec3 n(b.n[0][l], b.n[1][l], b.n[2][l]);
+      const auto jv = [&](const LaneRow& r) { return r.u.dot(c.v - a.v) + r.rb_u.dot(c.w) - r.ra_u.dot(a.w); };
       for (int i = 0; i < b.count[l]; ++i) {
         const ContactBatch::Point& q = b.p[i];
         if (q.valid[l] == 0) continue;
-        const Vec3 ra(q.ra[0][l], q.ra[1][l], q.ra[2][l]), rb(q.rb[0][l], q.rb[1][l], q.rb[2][l]);
-        const Vec3 dv = (c.v + c.w.cross(rb)) - (a.v + a.w.cross(ra));
         const Real cfm = b.cfm[l];
         const Real ln = q.lambda[l];
-        const Real wn = n.dot(dv) - q.rhs[l] + cfm * ln;
+        const Real wn = jv(laneRowParts(b, l, i, 0)) - q.rhs[l] + cfm * ln;
         worst = std::max(worst, std::abs(ln - std::max(ln - wn, Real(0))));
         if (b.mu[l] <= 0) continue;
-        const Vec3 t1(q.t[0][l], q.t[1][l], q.t[2][l]);
         const Real bound = b.mu[l] * ln;
         for (int k = 0; k < 2; ++k) {
-          const Vec3 t = k == 0 ? t1 : Vec3(n.cross(t1));
           const Real lt = q.lambda_t[k][l];
-          const Real wt = t.dot(dv) + cfm * lt;
+          const Real wt = jv(laneRowParts(b, l, i, 1 + k)) + cfm * lt;
           worst = std::max(worst, std::abs(lt - std::clamp(lt - wt, -bound, bound)));
         }
       }
@@ -235,10 +245,10 @@ namespace cairn::detail {
 
 namespace {
 
-// A manifold lane's row along u at point i, in the generic form.
-ConstraintRow laneRow(const ContactBatch& b, int l, int i, const Vec3& u, Real inv_diag, RowKind kind) {
-  const ContactBatch::Point& q = b.p[i];
-  const Vec3 ra(q.ra[0][l], q.ra[1][l], q.ra[2][l]), rb(q.rb[0][l], q.rb[1][l], q.rb[2][l]);
+// A manifold lane's row at point i (row 0: normal, 1, 2: tangents) in the
+// generic form.
+ConstraintRow laneRow(const ContactBatch& b, int l, int i, int row, Real inv_diag, RowKind kind) {
+  const LaneRow parts = laneRowParts(b, l, i, row);
   const Vec3 ma(b.ma[0][l], b.ma[1][l], b.ma[2][l]), mb(b.mb[0][l], b.mb[1][l], b.mb[2][l]);
   const auto sym = [&](const double (*m)[kBatchLanes]) {
     Mat3 r;
@@ -246,10 +256,10 @@ ConstraintRow laneRow(const ContactBatch& b, int l, int i, const Vec3& u, Real i
     return r;
   };
   ConstraintRow r;
-  r.j_lin_a = -u;
-  r.j_ang_a = -ra.cross(u);
-  r.j_lin_b = u;
-  r.j_ang_b = rb.cross(u);
+  r.j_lin_a = -parts.u;
+  r.j_ang_a = -parts.ra_u;
+  r.j_lin_b = parts.u;
+  r.j_ang_b = parts.rb_u;
   r.m_lin_a = ma.cwiseProduct(r.j_lin_a);
   r.m_ang_a = sym(b.ia) * r.j_ang_a;
   r.m_lin_b = mb.cwiseProduct(r.j_lin_b);
@@ -303,11 +313,10 @@ std::vector<ConstraintRow> WorldImpl::expandedRows() const {
     std::vector<std::int32_t> normal_at;
     for (const auto& [bi, l] : lanes) {
       const ContactBatch& b = g.batches[bi];
-      const Vec3 n(b.n[0][l], b.n[1][l], b.n[2][l]);
       for (int i = 0; i < kMaxPoints; ++i) {
         normal_at.push_back(-1);
         if (i >= b.count[l] || b.p[i].valid[l] == 0) continue;
-        ConstraintRow r = laneRow(b, l, i, n, b.p[i].normal_mass[l], RowKind::ContactNormal);
+        ConstraintRow r = laneRow(b, l, i, 0, b.p[i].normal_mass[l], RowKind::ContactNormal);
         r.body_a = remap(b.body_a[l]);
         r.body_b = remap(b.body_b[l]);
         r.rhs = b.p[i].rhs[l];
@@ -323,13 +332,10 @@ std::vector<ConstraintRow> WorldImpl::expandedRows() const {
     size_t point = 0;
     for (const auto& [bi, l] : lanes) {
       const ContactBatch& b = g.batches[bi];
-      const Vec3 n(b.n[0][l], b.n[1][l], b.n[2][l]);
       for (int i = 0; i < kMaxPoints; ++i, ++point) {
         if (normal_at[point] < 0 || b.mu[l] <= 0) continue;
-        const Vec3 t1(b.p[i].t[0][l], b.p[i].t[1][l], b.p[i].t[2][l]);
         for (int k = 0; k < 2; ++k) {
-          ConstraintRow r = laneRow(b, l, i, k == 0 ? t1 : Vec3(n.cross(t1)), b.p[i].tangent_mass[k][l],
-                                    RowKind::ContactFriction);
+          ConstraintRow r = laneRow(b, l, i, 1 + k, b.p[i].tangent_mass[k][l], RowKind::ContactFriction);
           r.body_a = remap(b.body_a[l]);
           r.body_b = remap(b.body_b[l]);
           r.lambda = b.p[i].lambda_t[k][l];

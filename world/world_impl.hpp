@@ -100,8 +100,9 @@ struct StepContext {
   std::vector<char> island_pushing;        // per island: some contact deeper than the slop (being pushed out)
   // Scratch of the colouring.
   std::vector<GraphItem> items, sorted_items;
-  std::vector<std::int32_t> colour_of, adj_start, adj, level, queue, level_start, last_colour;
+  std::vector<std::int32_t> colour_of, adj_start, adj, level, queue, level_start;
   std::vector<std::int32_t> groups_in, manifolds_in, group_fill, lane_fill;
+  std::vector<std::uint64_t> colour_used;  // per dynamic body: the current level's colours it is in
 
   // The other islands (direct, exact LCP): generic rows, island by island.
   std::vector<ConstraintRow> rows;

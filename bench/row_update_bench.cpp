@@ -1,0 +1,133 @@
+// The cost of one PGS row update in the step's solver, contacts and joints
+// apart, per instruction set (docs/performance.md records the figures).
+//
+//   BM_ContactRowUpdate/<kernels>   velocity sweeps over the contact
+//       manifolds of pyramid-20 after 60 steps (the settled pile's graph,
+//       captured from the World), one colour after another, as the step
+//       sweeps them. rows = valid points x 3 (one normal and two friction
+//       rows each); ns_per_row_update = time / (rows x sweeps).
+//   BM_JointRowUpdate   the same over the joint rows of chain-100 after 30
+//       steps (mid-whip), each joint's rows in order.
+//
+// The time is the thread's CPU time around the sweeps only (manual time):
+// a loaded machine that deschedules the thread does not inflate it, but it
+// still shares caches with whatever else runs, so compare figures taken in
+// one run. Kernels the CPU lacks are skipped.
+#include "solver/contact_kernels.hpp"
+#include "solver/graph_solver.hpp"
+#include "validation/scenarios.hpp"
+#include "world/world_access.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <ctime>
+#include <vector>
+
+namespace cairn::bench {
+namespace {
+
+double threadSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+struct Captured {
+  GraphProblem graph;
+  std::vector<SolverBody> velocities;
+  int dynamic_end = 1;
+  double contact_rows = 0, joint_rows = 0;
+};
+
+Captured capture(const char* scene_name, int steps) {
+  SceneDesc scene = scenarios::byName(scene_name);
+  scene.solver.sleeping = false;
+  World w = buildWorld(scene);
+  for (int s = 0; s < steps; ++s) w.step(scene.dt);
+  const detail::StepContext& ctx = detail::internals(w).stepContext();
+  Captured c;
+  c.graph = ctx.graph;
+  c.velocities = ctx.velocities;
+  c.dynamic_end = ctx.dynamic_count + 1;
+  for (const ContactBatch& b : c.graph.batches)
+    for (int l = 0; l < kBatchLanes; ++l)
+      for (int i = 0; i < b.count[l]; ++i)
+        if (b.p[i].valid[l] > 0) c.contact_rows += b.mu[l] > 0 ? 3 : 1;
+  c.joint_rows = static_cast<double>(c.graph.rows.size());
+  return c;
+}
+
+void BM_ContactRowUpdate(benchmark::State& state) {
+  const auto level = static_cast<SimdLevel>(state.range(0));
+  if (!simdLevelAvailable(level)) {
+    state.SkipWithError("instruction set not available here");
+    return;
+  }
+  static const Captured problem = capture("pyramid-20", 60);
+  const ContactKernels& k = contactKernels(level);
+  state.SetLabel(k.name);
+  constexpr int kSweeps = 10;
+  GraphProblem g = problem.graph;
+  std::vector<double> active(static_cast<size_t>(g.island_count), 1.0);
+  ContactSweepParams p;
+  p.dynamic_end = problem.dynamic_end;
+  p.island_active = active.data();
+  double seconds = 0, updates = 0;
+  for (auto _ : state) {
+    std::vector<SolverBody> v = problem.velocities;  // not timed
+    const double t0 = threadSeconds();
+    for (int s = 0; s < kSweeps; ++s) {  // a sweep as the step makes it: every normal block, then every friction row
+      for (const GraphColour& c : g.colours)
+        k.solve_normals(g.batches.data(), c.batch_begin, c.batch_end, v.front().v.data(), p);
+      for (const GraphColour& c : g.colours)
+        k.solve_friction(g.batches.data(), c.batch_begin, c.batch_end, v.front().v.data(), p);
+    }
+    benchmark::DoNotOptimize(v.data());
+    benchmark::ClobberMemory();
+    const double dt = threadSeconds() - t0;
+    state.SetIterationTime(dt);
+    seconds += dt;
+    updates += problem.contact_rows * kSweeps;
+  }
+  state.counters["rows"] = problem.contact_rows;
+  state.counters["colours"] = static_cast<double>(g.colours.size());
+  state.counters["batches"] = static_cast<double>(g.batches.size());
+  state.counters["ns_per_row_update"] = updates > 0 ? 1e9 * seconds / updates : 0;
+}
+BENCHMARK(BM_ContactRowUpdate)
+    ->ArgName("simd")
+    ->DenseRange(0, 2)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+void BM_JointRowUpdate(benchmark::State& state) {
+  static const Captured problem = capture("chain-100", 30);
+  constexpr int kSweeps = 10;
+  GraphProblem g = problem.graph;
+  GraphSolveOptions o;
+  o.iterations = kSweeps;
+  o.nncg = false;
+  o.dynamic_end = problem.dynamic_end;
+  o.kernels = &contactKernels(bestSimdLevel());
+  double seconds = 0, updates = 0;
+  std::uint64_t rng = 1;
+  for (auto _ : state) {
+    std::vector<SolverBody> v = problem.velocities;  // not timed
+    for (ConstraintRow& r : g.rows) r.lambda = 0;  // cold: every sweep works
+    const double t0 = threadSeconds();
+    const GraphSolveStats st = solveGraph(g, v, o, rng);
+    benchmark::DoNotOptimize(v.data());
+    benchmark::ClobberMemory();
+    const double dt = threadSeconds() - t0;
+    state.SetIterationTime(dt);
+    seconds += dt;
+    updates += problem.joint_rows * st.iterations;
+  }
+  state.counters["rows"] = problem.joint_rows;
+  state.counters["colours"] = static_cast<double>(g.colours.size());
+  state.counters["ns_per_row_update"] = updates > 0 ? 1e9 * seconds / updates : 0;
+}
+BENCHMARK(BM_JointRowUpdate)->UseManualTime()->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace cairn::bench

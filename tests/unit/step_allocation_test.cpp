@@ -1,0 +1,55 @@
+// The step allocates nothing once warmed up: every scratch array lives in
+// the step's context and keeps its capacity from step to step (as Box2D v3's
+// stack allocator and Jolt's temp allocator do), so a steady scene costs no
+// trips to the heap. Counted by replacing the global operator new in this
+// test binary; the count is read only around the steps under test.
+#include "test_helpers.hpp"
+#include "validation/scenarios.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+namespace {
+std::atomic<long> g_allocations{0};
+}
+
+void* operator new(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace cairn {
+namespace {
+
+// Allocations made by `steps` steps after `warmup` steps of the scene.
+long allocationsAfterWarmUp(SceneDesc s, int warmup, int steps) {
+  s.solver.sleeping = false;
+  World w = buildWorld(s);
+  for (int k = 0; k < warmup; ++k) w.step(s.dt);
+  const long before = g_allocations.load();
+  for (int k = 0; k < steps; ++k) w.step(s.dt);
+  return g_allocations.load() - before;
+}
+
+// A resting pyramid keeps its contact set: after the first second every
+// array has reached its size.
+TEST(StepAllocations, RestingPyramidAllocatesNothingAfterWarmUp) {
+  EXPECT_EQ(allocationsAfterWarmUp(scenarios::pyramid(10), 60, 60), 0);
+}
+
+// Joint rows only: the chain's row groups are rebuilt in place each step.
+TEST(StepAllocations, SwingingChainAllocatesNothingAfterWarmUp) {
+  EXPECT_EQ(allocationsAfterWarmUp(scenarios::chain(20), 60, 60), 0);
+}
+
+}  // namespace
+}  // namespace cairn

@@ -3,6 +3,7 @@
 #include "cairn/error.hpp"
 
 #include <cmath>
+#include <sstream>
 
 namespace cairn {
 
@@ -52,7 +53,11 @@ const char* rowKindName(RowKind k) {
 
 namespace {
 
-std::string num(Real v) { return std::to_string(v); }
+std::string num(Real v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 Vec3 requireAxis(const std::string& obj, const char* field, const Vec3& v) {
   if (!v.allFinite()) throw InputError(obj, field, "must be finite");

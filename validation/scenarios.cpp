@@ -193,6 +193,15 @@ SceneDesc awake(int steps) {
 
 Quat aboutAxis(Real angle, const Vec3& axis) { return Quat(Eigen::AngleAxis<Real>(angle, axis.normalized())); }
 
+BodyDef cuboid(const std::string& name, Real mass, const Vec3& p, const Vec3& half_extents) {
+  BodyDef b;
+  b.name = name;
+  b.mass = mass;
+  b.position = p;
+  b.shapes.push_back(ShapeDesc::box(half_extents));
+  return b;
+}
+
 JointDef hinge(const std::string& name, BodyId a, BodyId b, const Vec3& anchor, const Vec3& axis) {
   JointDef j;
   j.name = name;
@@ -418,18 +427,8 @@ SceneDesc ragdoll(bool six_dof) {
 //         1 m/s^2, slides at 0.4 m/s and stops on -0.3 m.
 SceneDesc motorLimits() {
   SceneDesc s = awake(120);
-  BodyDef arm;
-  arm.name = "arm";
-  arm.mass = 2;
-  arm.position = Vec3(0.5, 1, 0);
-  arm.shapes.push_back(ShapeDesc::box(Vec3(0.5, 0.05, 0.05)));
-  s.bodies.push_back(arm);
-  BodyDef cart;
-  cart.name = "cart";
-  cart.mass = 1;
-  cart.position = Vec3(0, 1, 2);
-  cart.shapes.push_back(ShapeDesc::box(Vec3(0.2, 0.2, 0.2)));
-  s.bodies.push_back(cart);
+  s.bodies.push_back(cuboid("arm", 2, Vec3(0.5, 1, 0), Vec3(0.5, 0.05, 0.05)));
+  s.bodies.push_back(cuboid("cart", 1, Vec3(0, 1, 2), Vec3(0.2, 0.2, 0.2)));
   JointDef h = hinge("hinge", BodyId{0}, kWorldBody, Vec3(0, 1, 0), Vec3::UnitY());
   h.limit = LimitDef{true, -0.4, 1.1, 0, {}};
   h.motor.enabled = true;
@@ -461,12 +460,9 @@ SceneDesc motorLimits() {
 // and with the anchor at its center every axis moves on its own.
 SceneDesc sixDof() {
   SceneDesc s = awake(180);
-  BodyDef cube;
-  cube.name = "cube";
-  cube.mass = 2;
+  BodyDef cube = cuboid("cube", 2, Vec3::Zero(), Vec3(0.2, 0.2, 0.2));
   cube.linear_velocity = Vec3(0.3, 0, 0);
   cube.angular_velocity = Vec3(0, 0.3, 0.5);
-  cube.shapes.push_back(ShapeDesc::box(Vec3(0.2, 0.2, 0.2)));
   s.bodies.push_back(cube);
   JointDef j;
   j.name = "six_dof";

@@ -63,21 +63,8 @@ JointDef sliderX(BodyId a, BodyId b, const Vec3& anchor = Vec3::Zero()) {
   return j;
 }
 
-MotorDef velocityMotor(Real target, Real max_force) {
-  MotorDef m;
-  m.enabled = true;
-  m.target_velocity = target;
-  m.max_force = max_force;
-  return m;
-}
-
-MotorDef servo(Real target, Real max_force) {
-  MotorDef m;
-  m.enabled = true;
-  m.target_position = target;
-  m.max_force = max_force;
-  return m;
-}
+MotorDef velocityMotor(Real target, Real max_force) { return MotorDef{true, target, max_force, {}, {}}; }
+MotorDef servo(Real target, Real max_force) { return MotorDef{true, 0, max_force, target, {}}; }
 
 // Rotation of q about world z (q turns about z only).
 Real turnZ(const Quat& q) { return 2 * std::atan2(q.z(), q.w()); }

@@ -35,7 +35,7 @@ void buildHingeRows(const Joint& j, const BodyView& a, const BodyView& b, RowCon
   const Real theta = hingeAngle(j, a, b);
   const RowJacobian rate = relativeRotation(ax_a);
   addLimitPart(ctx, a, b, 5, j.def.limit, angleNearLimits(theta, j.def.limit), rate, s.restitution_threshold);
-  if (j.def.motor.enabled) addMotorPart(ctx, a, b, 6, j.def.motor, theta, true, rate);
+  if (j.def.motor.enabled && !locks(j.def.limit)) addMotorPart(ctx, a, b, 6, j.def.motor, theta, true, rate);
 }
 
 }  // namespace cairn

@@ -46,13 +46,14 @@ RowJacobian relativeTravel(const BodyView& a, const BodyView& b, const Vec3& n, 
                            bool fixed_in_a) {
   // d/dt n.(p_a - p_b) = n.(v_pa - v_pb) + (w x n).(p_a - p_b) for w the
   // spin of the body n is fixed in; (w x n).d = w.(n x d) moves that body's
-  // lever arm from its own anchor to the other one.
+  // lever arm from its own anchor to the other one, so both arms reach the
+  // anchor of the body n is not fixed in.
+  const Vec3 p = fixed_in_a ? p_b : p_a;
   RowJacobian j;
   j.lin_a = n;
+  j.ang_a = (p - a.x).cross(n);
   j.lin_b = -n;
-  j.ang_a = (fixed_in_a ? p_b : p_a) - a.x;
-  j.ang_a = j.ang_a.cross(n);
-  j.ang_b = -((fixed_in_a ? p_b : p_a) - b.x).cross(n);
+  j.ang_b = -(p - b.x).cross(n);
   return j;
 }
 

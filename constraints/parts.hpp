@@ -140,6 +140,12 @@ void addMotorPart(RowContext& ctx, const BodyView& a, const BodyView& b, int slo
 // when only a stiffness is given; `effective_mass` is the row's.
 Softness servoSoftness(const Softness& motor_softness, Real effective_mass);
 
+// A limit with lower == upper holds its coordinate: a motor (or a spring)
+// on it has nothing to move, and ODE and Bullet switch it off
+// (dxJointLimitMotor::addLimot, btHingeConstraint::getInfo2Internal: "the
+// joint motor is ineffective"); cairn builds no row for it.
+inline bool locks(const LimitDef& l) { return l.enabled && l.lower == l.upper; }
+
 // True for the spring spellings (stiffness/damping, frequency/damping_ratio).
 inline bool isSpring(const Softness& s) { return s.stiffness || s.damping || s.frequency || s.damping_ratio; }
 

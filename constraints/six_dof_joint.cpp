@@ -28,7 +28,8 @@
 //
 // Rows per axis i: a limit or lock (slot i), a spring (6 + i), a motor
 // (12 + i). A spring is an implicit spring-damper toward its rest value
-// with no force bound; a motor is addMotorPart's.
+// with no force bound; a motor is addMotorPart's. A locked axis (or
+// lower == upper) gets neither: the lock holds it.
 #include "constraints/joint.hpp"
 
 #include <cmath>
@@ -99,6 +100,7 @@ void buildSixDofRows(const Joint& j, const BodyView& a, const BodyView& b, RowCo
     const Real s = angular ? angleNearLimits(c.s[i], limit) : c.s[i];
     ctx.kind = angular ? RowKind::JointAngular : RowKind::JointLinear;
     addLimitPart(ctx, a, b, i, limit, s, c.rate[i], settings.restitution_threshold);
+    if (locks(limit)) continue;  // a spring or motor would fight the lock
     if (dof.spring.enabled) {
       const Real stretch = angular ? wrapAngle(s - dof.spring.rest) : s - dof.spring.rest;
       addRow(ctx, a, b, 6 + i, c.rate[i], stretch, &dof.spring.softness);

@@ -35,7 +35,7 @@ void buildSliderRows(const Joint& j, const BodyView& a, const BodyView& b, RowCo
   const Real travel = -ax.dot(d);
   const RowJacobian rate = relativeTravel(a, b, ax, pa, pb, true);
   addLimitPart(ctx, a, b, 5, j.def.limit, travel, rate, s.restitution_threshold);
-  if (j.def.motor.enabled) addMotorPart(ctx, a, b, 6, j.def.motor, travel, false, rate);
+  if (j.def.motor.enabled && !locks(j.def.limit)) addMotorPart(ctx, a, b, 6, j.def.motor, travel, false, rate);
 }
 
 }  // namespace cairn

@@ -57,14 +57,8 @@ std::map<std::string, Real> defaultTolerances(const std::string& scenario, Valid
       t.erase("angle");
       t["reference_distance"] = 1.5;
     }
-  } else if (scenario == "door") {
-    t["position"] = 0.02;
-    t["angle"] = 0.03;
-    t["open_time"] = 1.0 / 60;
-    t["final_angle"] = 0.02;
-    t["joint_error"] = 0.001;
-  } else if (scenario == "motor-limits") {
-    // As the door: the engines part only at the stops (docs/validation.md).
+  } else if (scenario == "door" || scenario == "motor-limits") {
+    // The engines part only at the stops (docs/validation.md).
     t["position"] = 0.02;
     t["angle"] = 0.03;
     t["open_time"] = 1.0 / 60;

@@ -9,13 +9,7 @@ namespace cairn::scenarios {
 namespace {
 
 BodyDef box(const std::string& name, const Vec3& p, Real mass = 1) {
-  BodyDef d;
-  d.name = name;
-  d.mass = mass;
-  d.position = p;
-  d.friction = Real(0.5);
-  d.shapes.push_back(ShapeDesc::box(Vec3(0.5, 0.5, 0.5)));
-  return d;
+  return solid(name, mass, p, ShapeDesc::box(Vec3(0.5, 0.5, 0.5)));
 }
 
 SceneDesc base(int steps) {
@@ -26,6 +20,15 @@ SceneDesc base(int steps) {
 }
 
 }  // namespace
+
+BodyDef solid(const std::string& name, Real mass, const Vec3& position, ShapeDesc shape) {
+  BodyDef b;
+  b.name = name;
+  b.mass = mass;
+  b.position = position;
+  b.shapes.push_back(std::move(shape));
+  return b;
+}
 
 BodyDef ground() {
   BodyDef g;
@@ -194,12 +197,7 @@ SceneDesc awake(int steps) {
 Quat aboutAxis(Real angle, const Vec3& axis) { return Quat(Eigen::AngleAxis<Real>(angle, axis.normalized())); }
 
 BodyDef cuboid(const std::string& name, Real mass, const Vec3& p, const Vec3& half_extents) {
-  BodyDef b;
-  b.name = name;
-  b.mass = mass;
-  b.position = p;
-  b.shapes.push_back(ShapeDesc::box(half_extents));
-  return b;
+  return solid(name, mass, p, ShapeDesc::box(half_extents));
 }
 
 JointDef hinge(const std::string& name, BodyId a, BodyId b, const Vec3& anchor, const Vec3& axis) {

@@ -40,6 +40,9 @@ SceneDesc restitutionDrop(Real restitution);   // restitution-drop: a sphere of 
 SceneDesc byName(const std::string& key);
 std::vector<std::string> standardNames();
 
+// A dynamic body of one shape (friction 0.5, the BodyDef default).
+BodyDef solid(const std::string& name, Real mass, const Vec3& position, ShapeDesc shape);
+
 // Static ground: a box 200 x 1 x 200 m whose top face is y = 0 (Bullet
 // compares best with a box ground; a plane behaves the same in cairn).
 BodyDef ground();

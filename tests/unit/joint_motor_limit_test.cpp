@@ -63,6 +63,16 @@ JointDef sliderX(BodyId a, BodyId b, const Vec3& anchor = Vec3::Zero()) {
   return j;
 }
 
+// A wheel at the origin, listed first on a hinge about +z to the world,
+// driven by `motor`.
+BodyId motorizedWheel(World& w, const MotorDef& motor) {
+  const BodyId id = w.createBody(wheel("wheel", Vec3::Zero()));
+  JointDef j = hingeZ(id, kWorldBody);
+  j.motor = motor;
+  w.createJoint(j);
+  return id;
+}
+
 MotorDef velocityMotor(Real target, Real max_force) { return MotorDef{true, target, max_force, {}, {}}; }
 MotorDef servo(Real target, Real max_force) { return MotorDef{true, 0, max_force, target, {}}; }
 
@@ -267,10 +277,7 @@ TEST(SoftLimit, SliderStopIsADampedSpringUntilTheJointLeavesIt) {
 // within a step of t99 w / w'.
 TEST(Servo, CriticallyDampedByDefaultReachesItsTargetInTheClosedFormTime) {
   World w = awakeWorld();
-  const BodyId id = w.createBody(wheel("wheel", Vec3::Zero()));
-  JointDef j = hingeZ(id, kWorldBody);
-  j.motor = servo(1, 1000);
-  w.createJoint(j);
+  const BodyId id = motorizedWheel(w, servo(1, 1000));
   const Real omega = 2 * kPi * 2, hw = kH * omega;
   int n99 = -1;
   for (int n = 1; n <= 180; ++n) {
@@ -318,10 +325,7 @@ TEST(Servo, SliderFollowsTheContinuousCriticallyDampedResponseWithinTheStepError
 // the 0.1 N m allowed.
 TEST(Servo, TooSmallMaxForceTurnsAtTorqueOverInertia) {
   World w = awakeWorld();
-  const BodyId id = w.createBody(wheel("wheel", Vec3::Zero()));
-  JointDef j = hingeZ(id, kWorldBody);
-  j.motor = servo(1, 0.1);
-  w.createJoint(j);
+  const BodyId id = motorizedWheel(w, servo(1, 0.1));
   const Real a = 0.1 / kWheelInertia;
   for (int n = 1; n <= 60; ++n) {
     w.step(kH);
@@ -334,12 +338,10 @@ TEST(Servo, TooSmallMaxForceTurnsAtTorqueOverInertia) {
 // recurrence, overshooting the target.
 TEST(Servo, FrequencySpellingIsTheImplicitEulerOscillatorAboutTheTarget) {
   World w = awakeWorld();
-  const BodyId id = w.createBody(wheel("wheel", Vec3::Zero()));
-  JointDef j = hingeZ(id, kWorldBody);
-  j.motor = servo(-0.5, 1000);
-  j.motor.softness.frequency = 1;
-  j.motor.softness.damping_ratio = 0.3;
-  w.createJoint(j);
+  MotorDef m = servo(-0.5, 1000);
+  m.softness.frequency = 1;
+  m.softness.damping_ratio = 0.3;
+  const BodyId id = motorizedWheel(w, m);
   const Real omega = 2 * kPi;
   const Recurrence r{omega * omega, 2 * 0.3 * omega};
   Real x = 0.5, v = 0, lowest = 0;
@@ -358,23 +360,19 @@ TEST(Servo, FrequencySpellingIsTheImplicitEulerOscillatorAboutTheTarget) {
 // with the force bounded by max_force it first accelerates at tau / I.
 TEST(SoftVelocityMotor, ApproachesItsTargetThroughItsDamper) {
   const Real c = 0.5, target = 4;
+  MotorDef m = velocityMotor(target, 1000);
+  m.softness.damping = c;
   World w = awakeWorld();
-  const BodyId id = w.createBody(wheel("wheel", Vec3::Zero()));
-  JointDef j = hingeZ(id, kWorldBody);
-  j.motor = velocityMotor(target, 1000);
-  j.motor.softness.damping = c;
-  w.createJoint(j);
+  const BodyId id = motorizedWheel(w, m);
   for (int n = 1; n <= 120; ++n) {
     w.step(kH);
     const Real expected = target * (1 - std::pow(1 + kH * c / kWheelInertia, -n));
     ASSERT_NEAR(w.body(id).angular_velocity.z(), expected, 1e-9) << n;
   }
   // Bounded: the damper asks c target = 2 N m at the start; 0.5 N m is allowed.
+  m.max_force = 0.5;
   World w2 = awakeWorld();
-  const BodyId id2 = w2.createBody(wheel("wheel", Vec3::Zero()));
-  j.body_a = id2;
-  j.motor.max_force = 0.5;
-  w2.createJoint(j);
+  const BodyId id2 = motorizedWheel(w2, m);
   w2.step(kH);
   EXPECT_NEAR(w2.body(id2).angular_velocity.z(), 0.5 / kWheelInertia * kH, 1e-12);
 }

@@ -31,12 +31,7 @@ SceneDesc emptyScene(const Vec3& gravity = Vec3(0, -kG, 0)) {
 }
 
 BodyDef dynamicBody(const std::string& name, const Vec3& pos, ShapeDesc shape, Real mass = 1) {
-  BodyDef d;
-  d.name = name;
-  d.mass = mass;
-  d.position = pos;
-  d.shapes.push_back(std::move(shape));
-  return d;
+  return scenarios::solid(name, mass, pos, std::move(shape));
 }
 
 BodyDef box(const std::string& name, const Vec3& pos, Real mass = 1, const Vec3& he = Vec3(0.5, 0.5, 0.5)) {

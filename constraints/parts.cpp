@@ -58,8 +58,8 @@ RowJacobian relativeTravel(const BodyView& a, const BodyView& b, const Vec3& n, 
 }
 
 Real effectiveMass(const BodyView& a, const BodyView& b, const RowJacobian& j) {
-  const Real diag = a.inv_mass * (j.lin_a.squaredNorm()) + j.ang_a.dot(a.inv_inertia * j.ang_a) +
-                    b.inv_mass * (j.lin_b.squaredNorm()) + j.ang_b.dot(b.inv_inertia * j.ang_b);
+  const Real diag = a.inv_mass * j.lin_a.dot(a.lin_factor.cwiseProduct(j.lin_a)) + j.ang_a.dot(a.inv_inertia * j.ang_a) +
+                    b.inv_mass * j.lin_b.dot(b.lin_factor.cwiseProduct(j.lin_b)) + j.ang_b.dot(b.inv_inertia * j.ang_b);
   return diag > Real(1e-300) ? 1 / diag : 0;
 }
 

@@ -111,10 +111,10 @@ TEST(JointSigns, HingeMotorTurnsTheFirstBodyAtPlusTargetRelativeToTheSecond) {
   w.createJoint(j2);
   w.createJoint(j3);
   for (int s = 0; s < 30; ++s) w.step(kH);
-  EXPECT_NEAR(w.body(first).angular_velocity.z(), 3, 1e-9);
-  EXPECT_NEAR(w.body(second).angular_velocity.z(), -3, 1e-9);
-  EXPECT_NEAR(w.body(a).angular_velocity.z() - w.body(b).angular_velocity.z(), 3, 1e-9);
-  EXPECT_NEAR(w.body(a).angular_velocity.z() + w.body(b).angular_velocity.z(), 0, 1e-9);
+  EXPECT_NEAR(w.angularVelocity(first).z(), 3, 1e-9);
+  EXPECT_NEAR(w.angularVelocity(second).z(), -3, 1e-9);
+  EXPECT_NEAR(w.angularVelocity(a).z() - w.angularVelocity(b).z(), 3, 1e-9);
+  EXPECT_NEAR(w.angularVelocity(a).z() + w.angularVelocity(b).z(), 0, 1e-9);
 }
 
 TEST(JointSigns, SliderMotorMovesTheFirstBodyAtPlusTargetRelativeToTheSecond) {
@@ -128,8 +128,8 @@ TEST(JointSigns, SliderMotorMovesTheFirstBodyAtPlusTargetRelativeToTheSecond) {
   w.createJoint(j1);
   w.createJoint(j2);
   for (int s = 0; s < 30; ++s) w.step(kH);
-  EXPECT_NEAR(w.body(first).linear_velocity.x(), 0.5, 1e-9);
-  EXPECT_NEAR(w.body(second).linear_velocity.x(), -0.5, 1e-9);
+  EXPECT_NEAR(w.linearVelocity(first).x(), 0.5, 1e-9);
+  EXPECT_NEAR(w.linearVelocity(second).x(), -0.5, 1e-9);
 }
 
 // The hinge angle, slider travel and cone-twist twist are the first body's
@@ -160,9 +160,9 @@ TEST(JointSigns, LimitsBoundTheFirstBodyRelativeToTheSecond) {
     w.createJoint(slider);
     w.createJoint(cone);
     for (int n = 0; n < 60; ++n) w.step(kH);
-    EXPECT_NEAR(turnZ(w.body(h).orientation), dir > 0 ? 0.3 : -0.2, 1e-6);
-    EXPECT_NEAR(w.body(s).position.x() - 3, dir > 0 ? 0.15 : -0.25, 1e-6);
-    EXPECT_NEAR(turnZ(w.body(t).orientation), dir > 0 ? 0.4 : -0.1, 1e-6);
+    EXPECT_NEAR(turnZ(w.transform(h).q), dir > 0 ? 0.3 : -0.2, 1e-6);
+    EXPECT_NEAR(w.transform(s).p.x() - 3, dir > 0 ? 0.15 : -0.25, 1e-6);
+    EXPECT_NEAR(turnZ(w.transform(t).q), dir > 0 ? 0.4 : -0.1, 1e-6);
   }
 }
 
@@ -186,8 +186,8 @@ TEST(LockedLimit, HoldsFromBothSides) {
   }
   for (int n = 0; n < 120; ++n) {
     w.step(kH);
-    ASSERT_LT(std::abs(turnZ(w.body(right).orientation)), 1e-9) << n;
-    ASSERT_LT(std::abs(turnZ(w.body(left).orientation)), 1e-9) << n;
+    ASSERT_LT(std::abs(turnZ(w.transform(right).q)), 1e-9) << n;
+    ASSERT_LT(std::abs(turnZ(w.transform(left).q)), 1e-9) << n;
   }
 }
 
@@ -222,7 +222,7 @@ TEST(SoftLimit, LockedHingeSpringIsTheImplicitEulerOscillator) {
     for (int n = 0; n < 120; ++n) {
       r.step(x, v);
       w.step(kH);
-      const Quat& q = w.body(id).orientation;
+      const Quat& q = w.transform(id).q;
       const Real angle = 2 * std::atan2(q.y(), q.w());
       ASSERT_NEAR(wrapAngle(angle - rest), x, 1e-9) << n;
     }
@@ -260,7 +260,7 @@ TEST(SoftLimit, SliderStopIsADampedSpringUntilTheJointLeavesIt) {
       s += kH * v;
     }
     w.step(kH);
-    ASSERT_NEAR(w.body(id).position.x(), s, 1e-9) << n;
+    ASSERT_NEAR(w.transform(id).p.x(), s, 1e-9) << n;
   }
   EXPECT_TRUE(pulled);
   EXPECT_TRUE(left);
@@ -283,7 +283,7 @@ TEST(Servo, CriticallyDampedByDefaultReachesItsTargetInTheClosedFormTime) {
   for (int n = 1; n <= 180; ++n) {
     w.step(kH);
     const Real x = -(1 + n * hw / (1 + hw)) * std::pow(1 + hw, -n);
-    const Real angle = turnZ(w.body(id).orientation);
+    const Real angle = turnZ(w.transform(id).q);
     ASSERT_NEAR(angle - 1, x, 1e-9) << n;
     if (n99 < 0 && std::abs(angle - 1) < 0.01) n99 = n;
   }
@@ -314,7 +314,7 @@ TEST(Servo, SliderFollowsTheContinuousCriticallyDampedResponseWithinTheStepError
     w.step(h);
     const Real t = n * h;
     const Real exact = target - target * (1 + omega * t) * std::exp(-omega * t);
-    ASSERT_NEAR(w.body(id).position.x(), exact, bound) << n;
+    ASSERT_NEAR(w.transform(id).p.x(), exact, bound) << n;
   }
 }
 
@@ -329,7 +329,7 @@ TEST(Servo, TooSmallMaxForceTurnsAtTorqueOverInertia) {
   const Real a = 0.1 / kWheelInertia;
   for (int n = 1; n <= 60; ++n) {
     w.step(kH);
-    ASSERT_NEAR(turnZ(w.body(id).orientation), a * kH * kH * n * (n + 1) / 2, 1e-12) << n;
+    ASSERT_NEAR(turnZ(w.transform(id).q), a * kH * kH * n * (n + 1) / 2, 1e-12) << n;
   }
 }
 
@@ -348,7 +348,7 @@ TEST(Servo, FrequencySpellingIsTheImplicitEulerOscillatorAboutTheTarget) {
   for (int n = 1; n <= 120; ++n) {
     r.step(x, v);
     w.step(kH);
-    const Real angle = turnZ(w.body(id).orientation);
+    const Real angle = turnZ(w.transform(id).q);
     ASSERT_NEAR(angle + 0.5, x, 1e-9) << n;
     lowest = std::min(lowest, angle);
   }
@@ -367,14 +367,14 @@ TEST(SoftVelocityMotor, ApproachesItsTargetThroughItsDamper) {
   for (int n = 1; n <= 120; ++n) {
     w.step(kH);
     const Real expected = target * (1 - std::pow(1 + kH * c / kWheelInertia, -n));
-    ASSERT_NEAR(w.body(id).angular_velocity.z(), expected, 1e-9) << n;
+    ASSERT_NEAR(w.angularVelocity(id).z(), expected, 1e-9) << n;
   }
   // Bounded: the damper asks c target = 2 N m at the start; 0.5 N m is allowed.
   m.max_force = 0.5;
   World w2 = awakeWorld();
   const BodyId id2 = motorizedWheel(w2, m);
   w2.step(kH);
-  EXPECT_NEAR(w2.body(id2).angular_velocity.z(), 0.5 / kWheelInertia * kH, 1e-12);
+  EXPECT_NEAR(w2.angularVelocity(id2).z(), 0.5 / kWheelInertia * kH, 1e-12);
 }
 
 }  // namespace

@@ -154,7 +154,7 @@ struct Rig {
   void run(int steps) {
     for (int n = 0; n < steps; ++n) w.step(kH);
   }
-  const Body& body() const { return w.body(box); }
+  Transform pose() const { return w.transform(box); }
 };
 
 // The swing-twist coordinates of an orientation relative to the world
@@ -176,8 +176,8 @@ TEST(SixDof, AllLockedHoldsLikeAWeldWhenSolvedExactly) {
   r.j.anchor = Vec3(-0.5, 0.2, 0.1);
   r.create();
   r.run(120);
-  EXPECT_LT(r.body().position.norm(), 1e-9);
-  EXPECT_LT(rotationVectorFromQuat(r.body().orientation).norm(), 1e-9);
+  EXPECT_LT(r.pose().p.norm(), 1e-9);
+  EXPECT_LT(rotationVectorFromQuat(r.pose().q).norm(), 1e-9);
   EXPECT_LT(r.w.jointError(JointId{0}).linear, 1e-9);
 }
 
@@ -191,8 +191,8 @@ TEST(SixDof, MotorsDriveTheFirstBodyRelativeToTheSecond) {
   r.j.dofs[5].motor = MotorDef{true, -1.5, 100, {}, {}};
   r.create();
   r.run(30);
-  EXPECT_LT((r.body().linear_velocity - Vec3(0.5, 0, 0)).norm(), 1e-9);
-  EXPECT_LT((r.body().angular_velocity - Vec3(0, 0, -1.5)).norm(), 1e-9);
+  EXPECT_LT((r.w.linearVelocity(r.box) - Vec3(0.5, 0, 0)).norm(), 1e-9);
+  EXPECT_LT((r.w.angularVelocity(r.box) - Vec3(0, 0, -1.5)).norm(), 1e-9);
 }
 
 // Limits near 90 degrees: rotation_y in [-0.2, 1.5] (86 degrees), rotation_z
@@ -212,7 +212,7 @@ TEST(SixDof, SwingLimitsHoldNearNinetyDegrees) {
   Real top_y = -1, top_z = -1;
   for (int n = 0; n < 120; ++n) {
     r.w.step(kH);
-    const std::array<Real, 3> a = angles(r.body().orientation);
+    const std::array<Real, 3> a = angles(r.pose().q);
     ASSERT_LE(a[1], 1.5 + 2e-3) << n;
     ASSERT_GE(a[1], -0.2 - 2e-3) << n;
     ASSERT_LE(std::abs(a[2]), 0.4 + 2e-3) << n;
@@ -248,8 +248,8 @@ TEST(SixDof, SpringsAreTheImplicitEulerOscillator) {
     va = (va - kH * omega * omega * a) / (1 + kH * 2 * zeta * omega + kH * kH * omega * omega);
     a += kH * va;
     r.w.step(kH);
-    ASSERT_NEAR(r.body().position.y() - 0.1, y, 1e-9) << n;
-    ASSERT_NEAR(angles(r.body().orientation)[2] + 0.6, a, 1e-9) << n;
+    ASSERT_NEAR(r.pose().p.y() - 0.1, y, 1e-9) << n;
+    ASSERT_NEAR(angles(r.pose().q)[2] + 0.6, a, 1e-9) << n;
   }
 }
 
@@ -266,7 +266,7 @@ TEST(SixDof, ServoOnASwingAxisIsCriticallyDamped) {
   for (int n = 1; n <= 120; ++n) {
     r.w.step(kH);
     const Real x = -1.2 * (1 + n * hw / (1 + hw)) * std::pow(1 + hw, -n);
-    ASSERT_NEAR(angles(r.body().orientation)[1] - 1.2, x, 1e-9) << n;
+    ASSERT_NEAR(angles(r.pose().q)[1] - 1.2, x, 1e-9) << n;
   }
 }
 
@@ -278,9 +278,9 @@ TEST(SixDof, FreeAxesCarryTheirMotion) {
   r.j.dofs[3].mode = DofMode::Free;
   r.create();
   r.run(60);
-  EXPECT_LT((r.body().linear_velocity - Vec3(0.7, 0, 0)).norm(), 1e-12);
-  EXPECT_LT((r.body().angular_velocity - Vec3(1.3, 0, 0)).norm(), 1e-12);
-  EXPECT_NEAR(r.body().position.x(), 0.7, 1e-12);
+  EXPECT_LT((r.w.linearVelocity(r.box) - Vec3(0.7, 0, 0)).norm(), 1e-12);
+  EXPECT_LT((r.w.angularVelocity(r.box) - Vec3(1.3, 0, 0)).norm(), 1e-12);
+  EXPECT_NEAR(r.pose().p.x(), 0.7, 1e-12);
 }
 
 }  // namespace

@@ -132,6 +132,26 @@ Json bodyJson(const BodyDef& b) {
   Json shapes = Json::array();
   for (const ShapeDesc& s : b.shapes) shapes.push_back(shapeJson(s));
   j["shapes"] = shapes;
+  if (b.force != Vec3::Zero()) j["force"] = vec(b.force);
+  if (b.torque != Vec3::Zero()) j["torque"] = vec(b.torque);
+  if (!b.impulses.empty()) {
+    Json imps = Json::array();
+    for (const BodyDef::TimedImpulse& imp : b.impulses) {
+      Json i;
+      i["time"] = imp.time;
+      i["impulse"] = vec(imp.impulse);
+      if (imp.point) i["point"] = vec(*imp.point);
+      imps.push_back(i);
+    }
+    j["impulses"] = imps;
+  }
+  const auto axes = [](const std::vector<Vec3>& list) {
+    Json a = Json::array();
+    for (const Vec3& v : list) a.push_back(vec(v));
+    return a;
+  };
+  if (!b.lock_translation.empty()) j["lock_translation"] = axes(b.lock_translation);
+  if (!b.lock_rotation.empty()) j["lock_rotation"] = axes(b.lock_rotation);
   return j;
 }
 

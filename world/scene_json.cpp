@@ -164,6 +164,16 @@ ShapeDesc parseShape(const json& j, const std::string& object, const std::string
   return s;
 }
 
+// An array of [x, y, z] vectors (DOF lock axes); absent: none.
+std::vector<Vec3> vec3List(const Reader& r, const char* key) {
+  std::vector<Vec3> out;
+  if (!r.has(key)) return out;
+  const json& v = r.raw(key);
+  if (!v.is_array()) r.fail(key, "must be an array of [x, y, z] axes");
+  for (size_t i = 0; i < v.size(); ++i) out.push_back(r.vec3Of(v[i], std::string(key) + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
 BodyDef parseBody(const json& j, size_t index, const std::filesystem::path& base_dir) {
   std::string object = "body #" + std::to_string(index);
   if (j.is_object() && j.contains("name") && j["name"].is_string()) object = "body '" + j["name"].get<std::string>() + "'";
@@ -199,6 +209,25 @@ BodyDef parseBody(const json& j, size_t index, const std::filesystem::path& base
     for (size_t i = 0; i < shapes.size(); ++i)
       b.shapes.push_back(parseShape(shapes[i], object, "shapes[" + std::to_string(i) + "].", base_dir));
   }
+  b.force = r.vec3("force", Vec3::Zero());
+  b.torque = r.vec3("torque", Vec3::Zero());
+  if (r.has("impulses")) {
+    const json& imps = r.raw("impulses");
+    if (!imps.is_array()) r.fail("impulses", "must be an array of {time, impulse, point}");
+    for (size_t i = 0; i < imps.size(); ++i) {
+      Reader ir(imps[i], object, "impulses[" + std::to_string(i) + "].");
+      BodyDef::TimedImpulse imp;
+      if (!ir.has("time")) ir.fail("time", "missing: the time (s) the impulse is applied at");
+      if (!ir.has("impulse")) ir.fail("impulse", "missing: the impulse [x, y, z] (N s)");
+      imp.time = ir.number("time");
+      imp.impulse = ir.vec3("impulse");
+      if (ir.has("point")) imp.point = ir.vec3("point");
+      ir.finish();
+      b.impulses.push_back(imp);
+    }
+  }
+  b.lock_translation = vec3List(r, "lock_translation");
+  b.lock_rotation = vec3List(r, "lock_rotation");
   r.finish();
   return b;
 }

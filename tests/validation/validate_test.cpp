@@ -117,6 +117,16 @@ void expectSameScene(const SceneDesc& a, const SceneDesc& b) {
     EXPECT_EQ(x.ccd, y.ccd);
     EXPECT_EQ(x.collision_group, y.collision_group);
     EXPECT_EQ(x.collision_mask, y.collision_mask);
+    EXPECT_EQ(x.force, y.force);
+    EXPECT_EQ(x.torque, y.torque);
+    ASSERT_EQ(x.impulses.size(), y.impulses.size());
+    for (size_t k = 0; k < x.impulses.size(); ++k) {
+      EXPECT_EQ(x.impulses[k].time, y.impulses[k].time);
+      EXPECT_EQ(x.impulses[k].impulse, y.impulses[k].impulse);
+      EXPECT_EQ(x.impulses[k].point, y.impulses[k].point);
+    }
+    EXPECT_EQ(x.lock_translation, y.lock_translation);
+    EXPECT_EQ(x.lock_rotation, y.lock_rotation);
     ASSERT_EQ(x.shapes.size(), y.shapes.size());
     for (size_t k = 0; k < x.shapes.size(); ++k) {
       const ShapeDesc &p = x.shapes[k], &q = y.shapes[k];
@@ -272,6 +282,11 @@ TEST(SceneWriter, EveryFieldRoundTrips) {
   a.ccd = true;
   a.collision_group = 4;
   a.collision_mask = ~6u;
+  a.force = Vec3(0.5, -1, 2);
+  a.torque = Vec3(0, 0.25, -0.125);
+  a.impulses = {{0.1, Vec3(1, 0, 0), Vec3(0.1, 2.3, -0.3)}, {0.5, Vec3(0, -2, 0.5), std::nullopt}};
+  a.lock_translation = {Vec3::UnitZ()};
+  a.lock_rotation = {Vec3(1, 1, 0), Vec3::UnitY()};
   ShapeDesc cap = ShapeDesc::capsule(0.2, 0.4);
   cap.local.p = Vec3(0.1, 0, 0);
   cap.local.q = Quat(Eigen::AngleAxis<Real>(0.3, Vec3::UnitX()));

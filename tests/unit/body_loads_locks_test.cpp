@@ -28,14 +28,6 @@ namespace {
 constexpr Real kH = Real(1) / 60;
 constexpr Real kRoundOff = 1e-12;  // relative; see the file comment
 
-World quietWorld(const Vec3& gravity = Vec3::Zero()) {
-  World w(gravity);
-  SolverSettings s;
-  s.sleeping = false;
-  w.setSettings(s);
-  return w;
-}
-
 // ---------------------------------------------------------------- loads
 
 // A 2 kg ball of radius 0.5 m pushed by a constant force and turned by a
@@ -53,7 +45,7 @@ const char* kLoadedBall = R"({
 TEST(BodyLoads, ConstantForceFollowsSemiImplicitEulerClosedForm) {
   BodyDef d = test::sphereDef("ball", Vec3(1, 2, 3), 2);
   d.force = Vec3(3, -1, 0.5);
-  World w = quietWorld();
+  World w = test::awakeWorld();
   const BodyId id = w.createBody(d);
   const Vec3 x0 = w.centerOfMass(id);
   for (int n = 1; n <= 300; ++n) {
@@ -67,7 +59,7 @@ TEST(BodyLoads, ConstantForceFollowsSemiImplicitEulerClosedForm) {
 TEST(BodyLoads, ConstantTorqueOnASphereSpinsAtNhTauOverI) {
   BodyDef d = test::sphereDef("ball", Vec3::Zero(), 2);
   d.torque = Vec3(0, 0.2, -0.1);
-  World w = quietWorld();
+  World w = test::awakeWorld();
   const BodyId id = w.createBody(d);
   const Real inertia = Real(2) / 5 * 2 * 0.25;  // 2/5 m r^2
   ASSERT_NEAR(w.inertia(id)(0, 0), inertia, kRoundOff);
@@ -84,7 +76,7 @@ TEST(BodyLoads, TimedImpulsesActOnceAtTheirStep) {
   BodyDef d = test::sphereDef("ball", Vec3::Zero(), 2);
   const Vec3 p(0, 0, 4), r(0, 0.5, 0);
   d.impulses = {{0.5, p, r}, {0.25, Vec3(1, 0, 0), std::nullopt}};  // out of order on purpose
-  World w = quietWorld();
+  World w = test::awakeWorld();
   const BodyId id = w.createBody(d);
   const Real inertia = Real(2) / 5 * 2 * 0.25;
   Vec3 v = Vec3::Zero(), omega = Vec3::Zero();
@@ -119,7 +111,7 @@ TEST(BodyLoads, SceneFileKeysAreTheApisFields) {
   d.force = b.force;
   d.torque = b.torque;
   d.impulses = {{0.5, Vec3(0, 0, 4), Vec3(1, 2.5, 3)}, {0.25, Vec3(1, 0, 0), std::nullopt}};
-  World from_api = quietWorld();
+  World from_api = test::awakeWorld();
   const BodyId id = from_api.createBody(d);
   const BodyId fid = from_file.findBody("ball");
   for (int n = 0; n < 60; ++n) {
@@ -152,7 +144,7 @@ std::vector<Real> cornerZ(const World& w, BodyId id, const Vec3& he) {
 // round-off (it turns about z only).
 TEST(DofLocks, BoxPushedOffAxisNeverLeavesItsPlane) {
   const Vec3 he(0.4, 0.25, 0.3);
-  World w = quietWorld(Vec3(0, -9.81, 0));
+  World w = test::awakeWorld(Vec3(0, -9.81, 0));
   w.createBody(scenarios::ground());
   BodyDef d = test::boxDef("box", Vec3(0, he.y(), 0), 3, he);
   d.lock_translation = {Vec3::UnitZ()};
@@ -178,7 +170,7 @@ TEST(DofLocks, BoxPushedOffAxisNeverLeavesItsPlane) {
 // vertical to round-off. The same hit without the lock tips it over, so
 // the test sees the lock and not a gentle hit.
 Real capsuleTiltAfterSideHit(bool locked, Real* slid = nullptr) {
-  World w = quietWorld(Vec3(0, -9.81, 0));
+  World w = test::awakeWorld(Vec3(0, -9.81, 0));
   w.createBody(scenarios::ground());
   BodyDef cap = scenarios::solid("capsule", 5, Vec3(0, 0.8, 0), ShapeDesc::capsule(0.2, 0.6));
   if (locked) cap.lock_rotation = {Vec3::UnitX(), Vec3::UnitZ()};
@@ -216,7 +208,7 @@ TEST(DofLocks, LockedRotationTurnsAtTorqueOverTheInertiaAboutTheFreeAxis) {
   d.orientation = Quat(Eigen::AngleAxis<Real>(0.5, Vec3::UnitX()));
   d.lock_rotation = {Vec3::UnitX(), Vec3::UnitY()};
   d.torque = Vec3(0, 0, 0.4);
-  World w = quietWorld();
+  World w = test::awakeWorld();
   const BodyId id = w.createBody(d);
   const Mat3 inertia = w.inertia(id);
   ASSERT_GT(inertia.inverse()(2, 2), 2 / inertia(2, 2));  // the two differ

@@ -23,15 +23,9 @@ namespace {
 
 constexpr Real kH = Real(1) / 60;
 
-// A world without gravity, awake throughout: these tests follow motions
-// that slow to below the sleep threshold.
-World awakeWorld(const Vec3& gravity = Vec3::Zero()) {
-  World w(gravity);
-  SolverSettings s;
-  s.sleeping = false;
-  w.setSettings(s);
-  return w;
-}
+// Worlds without gravity, awake throughout (test::awakeWorld): these tests
+// follow motions that slow to below the sleep threshold.
+using test::awakeWorld;
 
 // A solid cylinder of 2 kg, radius 0.5 m, its axis along world z:
 // I_zz = m r^2 / 2 = 0.25 kg m^2.
@@ -227,6 +221,36 @@ TEST(SoftLimit, LockedHingeSpringIsTheImplicitEulerOscillator) {
       ASSERT_NEAR(wrapAngle(angle - rest), x, 1e-9) << n;
     }
   }
+}
+
+// The slider's counterpart: a locked soft limit (lower == upper = 0.3 m,
+// 2 Hz, zeta = 0.1) on a 1 kg box released at travel 0 is the damped
+// oscillator about 0.3 m, stepped by implicit Euler (k and c from the
+// row's effective mass, the box's 1 kg), on both sides of its rest point:
+// it overshoots past 0.3 m and is pulled back, then pushed again.
+TEST(SoftLimit, LockedSliderSpringIsTheImplicitEulerOscillatorOnBothSides) {
+  const Real f = 2, zeta = 0.1, rest = 0.3;
+  World w = awakeWorld();
+  const BodyId id = w.createBody(test::boxDef("box", Vec3::Zero(), 1, Vec3(0.1, 0.1, 0.1)));
+  JointDef j = sliderX(id, kWorldBody);
+  j.limit = LimitDef{true, rest, rest, 0, {}};
+  j.limit.softness.frequency = f;
+  j.limit.softness.damping_ratio = zeta;
+  w.createJoint(j);
+  const Real omega = 2 * kPi * f;
+  const Recurrence r{omega * omega, 2 * zeta * omega};
+  Real x = -rest, v = 0, highest = -rest;
+  int sign_changes = 0;
+  for (int n = 0; n < 120; ++n) {
+    const Real before = x;
+    r.step(x, v);
+    if ((before < 0) != (x < 0)) ++sign_changes;
+    highest = std::max(highest, x);
+    w.step(kH);
+    ASSERT_NEAR(w.transform(id).p.x() - rest, x, 1e-9) << n;
+  }
+  EXPECT_GT(highest, 0.1);       // well past the rest point, and back
+  EXPECT_GE(sign_changes, 3);
 }
 
 // A soft stop past its bound is a spring-damper that pulls as well as

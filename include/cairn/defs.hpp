@@ -59,12 +59,13 @@ struct BodyDef {
 
   // Degrees of freedom locked by the mass matrix (Jolt's AllowedDOFs,
   // Bullet's linear and angular factors): world axes the body may neither
-  // translate along nor rotate about. The effective inverse mass and
-  // inertia are projected so that no impulse or force moves the body along
-  // them, exactly (no constraint rows that could stretch). Translation
-  // locks take the world axes x, y and z (unit vectors, either sign); a
-  // translation along any other line is a slider joint's job. Rotation
-  // locks take any non-zero world vectors.
+  // translate along nor rotate about. The inverse mass and inertia become
+  // the constrained body's (dynamics/body.hpp), so that no impulse or force
+  // moves the body along them, exactly (no constraint rows that could
+  // stretch), and torques about the free axes meet the right inertia.
+  // Translation locks take the world axes x, y and z (unit vectors, either
+  // sign); a translation along any other line is a slider joint's job.
+  // Rotation locks take any non-zero world vectors.
   std::vector<Vec3> lock_translation;
   std::vector<Vec3> lock_rotation;
 };

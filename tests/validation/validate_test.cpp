@@ -677,10 +677,12 @@ TEST(CairnAgainstBullet, HingePendulumStaysWithinTolerance) {
 // scenes' tolerances (docs/validation.md says why each is what it is):
 // motor-limits, a hinge and a slider motor driving into asymmetric limits
 // (sign and value: the arm ends on +1.1 rad, the cart on -0.3 m, in both
-// engines), and six-dof, one axis of each kind on Bullet's
-// btGeneric6DofSpring2Constraint.
+// engines), six-dof, one axis of each kind on Bullet's
+// btGeneric6DofSpring2Constraint, and ragdoll-6dof, the ragdoll built of
+// six_dof joints (penetration, and joint error no worse than Bullet's
+// by half again).
 TEST(CairnAgainstBullet, MotorLimitAndSixDofScenesStayWithinTolerance) {
-  for (const std::string key : {"motor-limits", "six-dof"}) {
+  for (const std::string key : {"motor-limits", "six-dof", "ragdoll-6dof"}) {
     SCOPED_TRACE(key);
     const StandardScene s = standardScene(key);
     const SceneResult r = validateScene(s.scene, key, "test", s.description);

@@ -8,9 +8,10 @@
 //                t_a x ref): the span in the swing direction phi is
 //                1 / sqrt((cos phi / s1)^2 + (sin phi / s2)^2). One row about
 //                n = t_a x t_b / |.|, only at or past the cone     (0-1 row)
-//   twist        the twist part of the swing-twist decomposition of b's
-//                rotation away from its rest pose relative to a; one
-//                limit row about t_b, only at or past a bound    (0-1 row)
+//   twist        the twist part of the swing-twist decomposition of a's
+//                rotation away from its rest pose relative to b (the
+//                sign of every joint coordinate, docs/constraints.md);
+//                one limit row about t_b, only at or past a bound (0-1 row)
 #include "constraints/joint.hpp"
 
 #include <cmath>
@@ -20,12 +21,11 @@ namespace cairn {
 void coneTwistAngles(const Joint& j, const BodyView& a, const BodyView& b, Real& swing, Real& twist) {
   const Vec3 ta = worldVector(a, j.local_axis_a), tb = worldVector(b, j.local_axis_b);
   swing = std::acos(std::clamp(ta.dot(tb), Real(-1), Real(1)));
-  // Deviation of b from its rest orientation relative to a, in b's frame.
+  // Deviation of b from its rest orientation relative to a, in b's frame;
+  // a's twist relative to b is the opposite of b's relative to a.
   const Quat d = (a.q * j.rel_orientation0).conjugate() * b.q;
   const Real proj = d.vec().dot(j.local_axis_b);
-  twist = 2 * std::atan2(proj, d.w());
-  if (twist > kPi) twist -= 2 * kPi;
-  if (twist < -kPi) twist += 2 * kPi;
+  twist = wrapAngle(-2 * std::atan2(proj, d.w()));
 }
 
 void buildConeTwistRows(const Joint& j, const BodyView& a, const BodyView& b, RowContext& ctx,
@@ -36,7 +36,6 @@ void buildConeTwistRows(const Joint& j, const BodyView& a, const BodyView& b, Ro
   const Vec3 ta = worldVector(a, j.local_axis_a), tb = worldVector(b, j.local_axis_b);
   Real swing, twist;
   coneTwistAngles(j, a, b, swing, twist);
-  const Vec3 zero = Vec3::Zero();
 
   // Swing axis: t_a x t_b, or, while the axes are aligned, the direction the
   // relative spin is about to swing them (so a fast swing that would cross
@@ -57,9 +56,13 @@ void buildConeTwistRows(const Joint& j, const BodyView& a, const BodyView& b, Ro
     cone.lower = -kInf;
     cone.upper = 1 / std::sqrt(c * c + sn * sn);
     cone.softness = j.def.limit.softness;
-    addLimitPart(ctx, a, b, 3, cone, swing, zero, -n, zero, n, s.restitution_threshold);
+    RowJacobian opening;  // the swing angle grows with (w_b - w_a).n
+    opening.ang_a = -n;
+    opening.ang_b = n;
+    addLimitPart(ctx, a, b, 3, cone, swing, opening, s.restitution_threshold);
   }
-  if (j.def.limit.enabled) addLimitPart(ctx, a, b, 4, j.def.limit, twist, zero, -tb, zero, tb, s.restitution_threshold);
+  if (j.def.limit.enabled) addLimitPart(ctx, a, b, 4, j.def.limit, angleNearLimits(twist, j.def.limit), relativeRotation(tb),
+                                           s.restitution_threshold);
 }
 
 }  // namespace cairn

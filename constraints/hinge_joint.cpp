@@ -5,15 +5,17 @@
 //                    (the small rotation from a's axis to b's),
 //                    C_p = e.p and C_q = e.q for p, q perpendicular
 //                    to ax_a; J = [0, -p, 0, p] and [0, -q, 0, q]  (2 rows)
-//   limit            on theta, the angle of b about ax_a relative to a,
-//                    only at or past a bound                     (0-1 row)
-//   motor            theta' -> target, |lambda| <= max torque h (0-1 row)
+//   limit            on theta, the angle of a about ax_a relative to b
+//                    (ODE's dJointGetHingeAngle, Bullet's getHingeAngle),
+//                    J = [0, ax_a, 0, -ax_a]                      (0-1 row)
+//   motor            theta' -> target_velocity or theta -> target_position,
+//                    |lambda| <= max torque h                    (0-1 row)
 #include "constraints/joint.hpp"
 
 namespace cairn {
 
 Real hingeAngle(const Joint& j, const BodyView& a, const BodyView& b) {
-  return angleAbout(worldVector(a, j.local_axis_a), worldVector(a, j.local_ref_a), worldVector(b, j.local_ref_b));
+  return angleAbout(worldVector(a, j.local_axis_a), worldVector(b, j.local_ref_b), worldVector(a, j.local_ref_a));
 }
 
 void buildHingeRows(const Joint& j, const BodyView& a, const BodyView& b, RowContext& ctx, const JointRowSettings& s) {
@@ -29,11 +31,11 @@ void buildHingeRows(const Joint& j, const BodyView& a, const BodyView& b, RowCon
   addAnglePart(ctx, a, b, 3, p, e.dot(p));
   addAnglePart(ctx, a, b, 4, q, e.dot(q));
 
-  const Vec3 zero = Vec3::Zero();
-  if (j.def.limit.enabled)
-    addLimitPart(ctx, a, b, 5, j.def.limit, hingeAngle(j, a, b), zero, -ax_a, zero, ax_a, s.restitution_threshold);
-  if (j.def.motor.enabled)
-    addMotorPart(ctx, a, b, 6, j.def.motor.target_velocity, j.def.motor.max_force, zero, -ax_a, zero, ax_a);
+  if (!j.def.limit.enabled && !j.def.motor.enabled) return;
+  const Real theta = hingeAngle(j, a, b);
+  const RowJacobian rate = relativeRotation(ax_a);
+  addLimitPart(ctx, a, b, 5, j.def.limit, angleNearLimits(theta, j.def.limit), rate, s.restitution_threshold);
+  if (j.def.motor.enabled && !locks(j.def.limit)) addMotorPart(ctx, a, b, 6, j.def.motor, theta, true, rate);
 }
 
 }  // namespace cairn

@@ -3,6 +3,7 @@
 #include "cairn/error.hpp"
 
 #include <cmath>
+#include <sstream>
 
 namespace cairn {
 
@@ -16,8 +17,24 @@ const char* jointTypeName(JointType t) {
     case JointType::ConeTwist: return "cone_twist";
     case JointType::Distance: return "distance";
     case JointType::AngularMotor: return "angular_motor";
+    case JointType::SixDof: return "six_dof";
   }
   return "unknown";
+}
+
+const char* dofModeName(DofMode m) {
+  switch (m) {
+    case DofMode::Free: return "free";
+    case DofMode::Limited: return "limited";
+    case DofMode::Locked: return "locked";
+  }
+  return "unknown";
+}
+
+const char* dofName(int dof) {
+  static const char* names[kDofCount] = {"translation_x", "translation_y", "translation_z",
+                                         "rotation_x",    "rotation_y",    "rotation_z"};
+  return dof >= 0 && dof < kDofCount ? names[dof] : "unknown";
 }
 
 const char* rowKindName(RowKind k) {
@@ -36,12 +53,84 @@ const char* rowKindName(RowKind k) {
 
 namespace {
 
-std::string num(Real v) { return std::to_string(v); }
+std::string num(Real v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 Vec3 requireAxis(const std::string& obj, const char* field, const Vec3& v) {
   if (!v.allFinite()) throw InputError(obj, field, "must be finite");
   if (v.norm() < Real(1e-9)) throw InputError(obj, field, "zero axis");
   return v.normalized();
+}
+
+}  // namespace
+
+namespace {
+
+bool hasLimit(JointType t) { return t == JointType::Hinge || t == JointType::Slider || t == JointType::ConeTwist; }
+bool hasMotor(JointType t) { return t == JointType::Hinge || t == JointType::Slider; }
+
+// `angular`: the coordinate is an angle in (-pi, pi], so a bound outside
+// [-pi, pi] could never be reached.
+void validateLimit(const LimitDef& l, const Softness& joint_softness, const std::string& obj, const std::string& p,
+                   bool angular) {
+  if (!std::isfinite(l.lower)) throw InputError(obj, p + "lower", "must be finite");
+  if (!std::isfinite(l.upper)) throw InputError(obj, p + "upper", "must be finite");
+  if (l.lower > l.upper) throw InputError(obj, p + "lower", "lower > upper (" + num(l.lower) + " > " + num(l.upper) + ")");
+  if (angular && (l.lower < -kPi || l.upper > kPi))
+    throw InputError(obj, p + (l.lower < -kPi ? "lower" : "upper"), "an angle limit must lie in [-pi, pi]");
+  validateSoftness(l.softness, obj, p);
+  if (!std::isfinite(l.restitution) || l.restitution < 0 || l.restitution > 1)
+    throw InputError(obj, p + "restitution", "must lie in [0, 1]");
+  if (l.restitution > 0 && l.lower == l.upper)
+    throw InputError(obj, p + "restitution", "a locked axis (lower == upper) does not bounce");
+  if (l.restitution > 0 && isSpring(l.softness.isSet() ? l.softness : joint_softness))
+    throw InputError(obj, p + "restitution", "a soft limit (stiffness/damping or frequency) bounces on its spring");
+}
+
+void validateMotor(const MotorDef& m, const std::string& obj, const std::string& p) {
+  if (!m.enabled) return;
+  if (!std::isfinite(m.target_velocity)) throw InputError(obj, p + "target_velocity", "must be finite");
+  if (!m.max_force) throw InputError(obj, p + "max_force", "missing: a motor needs its largest force (N) or torque (N m)");
+  if (!std::isfinite(*m.max_force) || *m.max_force < 0)
+    throw InputError(obj, p + "max_force", "must be finite and >= 0 (got " + num(*m.max_force) + ")");
+  validateSoftness(m.softness, obj, p);
+  const Softness& s = m.softness;
+  if (m.target_position) {
+    if (!std::isfinite(*m.target_position)) throw InputError(obj, p + "target_position", "must be finite");
+    if (m.target_velocity != 0)
+      throw InputError(obj, p + "target_velocity", "give target_velocity (a velocity motor) or target_position (a servo), not both");
+    if (s.erp || s.cfm)
+      throw InputError(obj, p + (s.erp ? "erp" : "cfm"), "a servo's softness is a spring: stiffness/damping or frequency/damping_ratio");
+    if (s.damping && !s.stiffness) throw InputError(obj, p + "damping", "a servo needs a stiffness (or a frequency)");
+  } else {
+    const char* spring = s.stiffness ? "stiffness" : s.frequency ? "frequency" : s.damping_ratio ? "damping_ratio" : s.erp ? "erp" : nullptr;
+    if (spring)
+      throw InputError(obj, p + spring, "a velocity motor's softness is a damper: damping (N s/m, N m s/rad) or cfm");
+  }
+}
+
+void validateSixDof(const JointDef& d, const std::string& obj) {
+  for (int i = 0; i < kDofCount; ++i) {
+    const DofDef& dof = d.dofs[static_cast<size_t>(i)];
+    const std::string p = std::string("dofs.") + dofName(i) + ".";
+    const bool angular = i >= 3;
+    if (dof.mode == DofMode::Limited) validateLimit(dof.limit, d.softness, obj, p + "limits.", angular);
+    else if (dof.limit.enabled)
+      throw InputError(obj, p + "limits", std::string("a ") + dofModeName(dof.mode) + " axis has no limits (mode \"limited\")");
+    if (dof.spring.enabled) {
+      const Softness& s = dof.spring.softness;
+      validateSoftness(s, obj, p + "spring.");
+      if (!s.stiffness && !s.frequency)
+        throw InputError(obj, p + "spring.stiffness", "a spring needs a stiffness or a frequency");
+      if (s.erp || s.cfm) throw InputError(obj, p + "spring.erp", "a spring is given by stiffness/damping or frequency/damping_ratio");
+      if (!std::isfinite(dof.spring.rest) || (angular && std::abs(dof.spring.rest) > kPi))
+        throw InputError(obj, p + "spring.rest", angular ? "must lie in [-pi, pi]" : "must be finite");
+    }
+    validateMotor(dof.motor, obj, p + "motor.");
+  }
 }
 
 }  // namespace
@@ -54,27 +143,24 @@ void validateJointDef(const JointDef& d, int body_count) {
     throw InputError(obj, "bodies", d.body_a.isWorld() ? "a joint needs at least one body" : "a joint between a body and itself");
   if (!d.anchor.allFinite()) throw InputError(obj, "anchor", "must be finite");
   const bool uses_axis = d.type == JointType::Hinge || d.type == JointType::Slider || d.type == JointType::Universal ||
-                         d.type == JointType::ConeTwist;
+                         d.type == JointType::ConeTwist || d.type == JointType::SixDof;
   if (uses_axis) requireAxis(obj, "axis", d.axis);
-  if (d.type == JointType::Universal) {
+  if (d.type == JointType::Universal || d.type == JointType::SixDof) {
     const Vec3 a2 = requireAxis(obj, "axis2", d.axis2);
     if (std::abs(a2.dot(d.axis.normalized())) > Real(1e-3))
       throw InputError(obj, "axis2", "must be perpendicular to axis");
   }
   if (d.limit.enabled) {
-    if (!std::isfinite(d.limit.lower) || !std::isfinite(d.limit.upper))
-      throw InputError(obj, "limits", "lower and upper must be finite");
-    if (d.limit.lower > d.limit.upper)
-      throw InputError(obj, "limits", "lower > upper (" + num(d.limit.lower) + " > " + num(d.limit.upper) + ")");
-    if (!std::isfinite(d.limit.restitution) || d.limit.restitution < 0 || d.limit.restitution > 1)
-      throw InputError(obj, "limits.restitution", "must lie in [0, 1]");
-    validateSoftness(d.limit.softness, obj, "limits.");
+    if (!hasLimit(d.type))
+      throw InputError(obj, "limits", std::string("a ") + jointTypeName(d.type) + " joint has no limits" +
+                                          (d.type == JointType::SixDof ? " of its own (give them per axis in dofs)" : ""));
+    validateLimit(d.limit, d.softness, obj, "limits.", d.type != JointType::Slider);
   }
-  if (d.motor.enabled) {
-    if (!std::isfinite(d.motor.target_velocity)) throw InputError(obj, "motor.target_velocity", "must be finite");
-    if (!std::isfinite(d.motor.max_force) || d.motor.max_force < 0)
-      throw InputError(obj, "motor.max_force", "must be finite and >= 0 (got " + num(d.motor.max_force) + ")");
-  }
+  if (d.motor.enabled && !hasMotor(d.type))
+    throw InputError(obj, "motor", std::string("a ") + jointTypeName(d.type) + " joint has no motor" +
+                                       (d.type == JointType::SixDof ? " of its own (give one per axis in dofs)" : ""));
+  validateMotor(d.motor, obj, "motor.");
+  if (d.type == JointType::SixDof) validateSixDof(d, obj);
   if (d.type == JointType::AngularMotor) {
     if (d.motor_axes.empty() || d.motor_axes.size() > 3) throw InputError(obj, "motor", "an angular motor has 1 to 3 axes");
     if (d.motor_targets.size() != d.motor_axes.size() || d.motor_max_torques.size() != d.motor_axes.size())
@@ -123,6 +209,15 @@ Joint makeJoint(const JointDef& def, const BodyView& a, const BodyView& b) {
   j.local_ref_a = a.q.conjugate() * ref;
   j.local_ref_b = b.q.conjugate() * ref;
   if (def.type == JointType::Universal) j.local_axis2_b = b.q.conjugate() * def.axis2.normalized();
+  if (def.type == JointType::SixDof) {
+    Mat3 frame;  // x = axis, y = axis2 made exactly perpendicular, z = x cross y
+    frame.col(0) = axis;
+    frame.col(1) = (def.axis2 - axis * axis.dot(def.axis2)).normalized();
+    frame.col(2) = frame.col(0).cross(frame.col(1));
+    const Quat f(frame);
+    j.local_frame_a = (a.q.conjugate() * f).normalized();
+    j.local_frame_b = (b.q.conjugate() * f).normalized();
+  }
   j.rel_orientation0 = (a.q.conjugate() * b.q).normalized();
   for (const Vec3& ax : def.motor_axes) j.local_motor_axes.push_back(a.q.conjugate() * ax.normalized());
   return j;
@@ -138,6 +233,7 @@ void buildJointRows(const Joint& j, const BodyView& a, const BodyView& b, RowCon
     case JointType::ConeTwist: buildConeTwistRows(j, a, b, ctx, s); break;
     case JointType::Distance: buildDistanceRows(j, a, b, ctx); break;
     case JointType::AngularMotor: buildAngularMotorRows(j, a, b, ctx); break;
+    case JointType::SixDof: buildSixDofRows(j, a, b, ctx, s); break;
   }
 }
 
@@ -155,7 +251,7 @@ JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& 
       break;
     case JointType::Hinge:
       e.linear = (pb - pa).norm();
-      e.angular = std::max(std::asin(std::min(Real(1), axa.cross(axb).norm())), beyond(j.def.limit, hingeAngle(j, a, b)));
+      e.angular = std::max(std::asin(std::min(Real(1), axa.cross(axb).norm())), beyond(j.def.limit, angleNearLimits(hingeAngle(j, a, b), j.def.limit)));
       break;
     case JointType::Slider: {
       const Vec3 d = pb - pa;
@@ -175,7 +271,7 @@ JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& 
       e.linear = (pb - pa).norm();
       Real swing, twist;
       coneTwistAngles(j, a, b, swing, twist);
-      e.angular = std::max(beyond(j.def.limit, twist), std::max(Real(0), swing - std::max(j.def.swing_span1, j.def.swing_span2)));
+      e.angular = std::max(beyond(j.def.limit, angleNearLimits(twist, j.def.limit)), std::max(Real(0), swing - std::max(j.def.swing_span1, j.def.swing_span2)));
       break;
     }
     case JointType::Distance:
@@ -183,6 +279,19 @@ JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& 
       break;
     case JointType::AngularMotor:
       break;
+    case JointType::SixDof: {
+      const std::array<Real, kDofCount> c = sixDofCoordinates(j, a, b);
+      for (int i = 0; i < kDofCount; ++i) {
+        const DofDef& dof = j.def.dofs[static_cast<size_t>(i)];
+        LimitDef l = dof.limit;
+        l.enabled = dof.mode == DofMode::Limited;
+        const Real off = dof.mode == DofMode::Locked ? std::abs(i >= 3 ? wrapAngle(c[i]) : c[i])
+                                                      : beyond(l, i >= 3 ? angleNearLimits(c[i], l) : c[i]);
+        Real& e_i = i < 3 ? e.linear : e.angular;
+        e_i = std::max(e_i, off);
+      }
+      break;
+    }
   }
   return e;
 }

@@ -16,6 +16,12 @@
 //   cone_twist    point 0-2, swing 3, twist 4
 //   distance      one linear 0
 //   angular_motor up to three angular 0-2
+//   six_dof       per axis i (translation x, y, z, rotation x, y, z):
+//                 limit or lock i, spring 6 + i, motor 12 + i
+//
+// Limits and motors act on coordinates measured as body a relative to body
+// b (hinge angle, slider travel, cone-twist twist, six_dof axes), ODE's and
+// Bullet's convention (docs/constraints.md, "Sign conventions").
 #pragma once
 
 #include "constraints/parts.hpp"
@@ -28,7 +34,7 @@
 
 namespace cairn {
 
-inline constexpr int kMaxJointRows = 7;
+inline constexpr int kMaxJointRows = 3 * kDofCount;  // six_dof
 
 struct Joint {
   JointDef def;
@@ -42,6 +48,7 @@ struct Joint {
   Vec3 local_axis_a = Vec3::UnitZ(), local_axis_b = Vec3::UnitZ();
   Vec3 local_ref_a = Vec3::UnitX(), local_ref_b = Vec3::UnitX();  // perpendicular to the axis
   Vec3 local_axis2_b = Vec3::UnitX();                             // universal joint
+  Quat local_frame_a = Quat::Identity(), local_frame_b = Quat::Identity();  // six_dof: x = axis, y = axis2
   Quat rel_orientation0 = Quat::Identity();                       // q_a^-1 q_b at creation
   Real length = 0;                                                // distance joint
   std::vector<Vec3> local_motor_axes;                             // angular motor, in a's frame
@@ -77,12 +84,17 @@ void buildUniversalRows(const Joint&, const BodyView&, const BodyView&, RowConte
 void buildConeTwistRows(const Joint&, const BodyView&, const BodyView&, RowContext&, const JointRowSettings&);
 void buildDistanceRows(const Joint&, const BodyView&, const BodyView&, RowContext&);
 void buildAngularMotorRows(const Joint&, const BodyView&, const BodyView&, RowContext&);
+void buildSixDofRows(const Joint&, const BodyView&, const BodyView&, RowContext&, const JointRowSettings&);
 
-// Hinge angle of b relative to a about the hinge axis (rad, in (-pi, pi]).
+// Hinge angle of a relative to b about the hinge axis (rad, in (-pi, pi]).
 Real hingeAngle(const Joint& j, const BodyView& a, const BodyView& b);
-// Slider translation of b relative to a along the axis (m).
+// Slider travel of a relative to b along the axis (m).
 Real sliderPosition(const Joint& j, const BodyView& a, const BodyView& b);
-// Cone-twist: swing angle (between the twist axes) and twist angle.
+// Cone-twist: swing angle (between the twist axes) and twist angle (a
+// relative to b).
 void coneTwistAngles(const Joint& j, const BodyView& a, const BodyView& b, Real& swing, Real& twist);
+// six_dof: the translations (m) and the twist and swing angles (rad) of a
+// relative to b, indexed as Dof.
+std::array<Real, kDofCount> sixDofCoordinates(const Joint& j, const BodyView& a, const BodyView& b);
 
 }  // namespace cairn

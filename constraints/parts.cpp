@@ -23,7 +23,58 @@ Real correctionBias(const RowContext& ctx, const ErpCfm& soft, Real c, const Vec
   return asked > ctx.max_correction_velocity ? bias * (ctx.max_correction_velocity / asked) : bias;
 }
 
+// A speculative limit row (the bound not reached yet): its target is the
+// rate that closes the gap within the step, in the velocity pass and in a
+// separate correction pass alike. Left at the bias pass's zero (no
+// position error), that pass would stop the joint a step short of the
+// bound and leave Baumgarte to close the last step's travel.
+void speculate(ConstraintRow& r, Real target) {
+  r.rhs = target;
+  if (r.correction != Correction::InRhs) r.bias_rhs = target;
+}
+
 }  // namespace
+
+RowJacobian relativeRotation(const Vec3& u) {
+  RowJacobian j;
+  j.ang_a = u;
+  j.ang_b = -u;
+  return j;
+}
+
+RowJacobian relativeTravel(const BodyView& a, const BodyView& b, const Vec3& n, const Vec3& p_a, const Vec3& p_b,
+                           bool fixed_in_a) {
+  // d/dt n.(p_a - p_b) = n.(v_pa - v_pb) + (w x n).(p_a - p_b) for w the
+  // spin of the body n is fixed in; (w x n).d = w.(n x d) moves that body's
+  // lever arm from its own anchor to the other one, so both arms reach the
+  // anchor of the body n is not fixed in.
+  const Vec3 p = fixed_in_a ? p_b : p_a;
+  RowJacobian j;
+  j.lin_a = n;
+  j.ang_a = (p - a.x).cross(n);
+  j.lin_b = -n;
+  j.ang_b = -(p - b.x).cross(n);
+  return j;
+}
+
+Real effectiveMass(const BodyView& a, const BodyView& b, const RowJacobian& j) {
+  const Real diag = a.inv_mass * j.lin_a.dot(a.lin_factor.cwiseProduct(j.lin_a)) + j.ang_a.dot(a.inv_inertia * j.ang_a) +
+                    b.inv_mass * j.lin_b.dot(b.lin_factor.cwiseProduct(j.lin_b)) + j.ang_b.dot(b.inv_inertia * j.ang_b);
+  return diag > Real(1e-300) ? 1 / diag : 0;
+}
+
+Real wrapAngle(Real x) {
+  x = std::remainder(x, 2 * kPi);  // [-pi, pi]
+  return x <= -kPi ? x + 2 * kPi : x;
+}
+
+Real angleNearLimits(Real s, const LimitDef& l) {
+  if (!l.enabled) return s;
+  if (l.lower == l.upper) return l.lower + wrapAngle(s - l.lower);
+  if (s < l.lower && std::abs(wrapAngle(l.lower - s)) >= std::abs(wrapAngle(l.upper - s))) return s + 2 * kPi;
+  if (s > l.upper && std::abs(wrapAngle(s - l.upper)) >= std::abs(wrapAngle(s - l.lower))) return s - 2 * kPi;
+  return s;
+}
 
 int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, const Vec3& lin_a, const Vec3& ang_a,
            const Vec3& lin_b, const Vec3& ang_b, Real c, const Softness* axis_softness, Real lo, Real hi) {
@@ -95,48 +146,81 @@ void addOrientationPart(RowContext& ctx, const BodyView& a, const BodyView& b, i
 }
 
 void addLimitPart(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, const LimitDef& limit, Real s,
-                  const Vec3& lin_a, const Vec3& ang_a, const Vec3& lin_b, const Vec3& ang_b, Real threshold) {
+                  const RowJacobian& j, Real threshold) {
   if (!limit.enabled) return;
-  const Real rate = lin_a.dot(a.v) + ang_a.dot(a.w) + lin_b.dot(b.v) + ang_b.dot(b.w);
-  const Real to_lower = s - limit.lower;  // >= 0 inside
-  const Real to_upper = limit.upper - s;  // >= 0 inside
   const RowKind saved = ctx.kind;
   ctx.kind = RowKind::Limit;
-  // Lower bound: the row may only push s up (lambda >= 0).
-  if (to_lower <= 0 || to_lower + ctx.h * rate < 0) {
-    const int i = addRow(ctx, a, b, slot, lin_a, ang_a, lin_b, ang_b, std::min(to_lower, Real(0)),
-                         &limit.softness, 0, kInf);
-    if (i >= 0) {
-      ConstraintRow& r = (*ctx.rows)[i];
-      if (to_lower > 0) r.rhs = -to_lower / ctx.h;  // speculative: close the gap, no more
-      if (limit.restitution > 0 && -rate > threshold) r.rhs = std::max(r.rhs, -limit.restitution * rate);
-    }
-  } else if (to_upper <= 0 || to_upper - ctx.h * rate < 0) {
-    const int i = addRow(ctx, a, b, slot, lin_a, ang_a, lin_b, ang_b, -std::min(to_upper, Real(0)),
-                         &limit.softness, -kInf, 0);
-    if (i >= 0) {
-      ConstraintRow& r = (*ctx.rows)[i];
-      if (to_upper > 0) r.rhs = to_upper / ctx.h;
-      if (limit.restitution > 0 && rate > threshold) r.rhs = std::min(r.rhs, -limit.restitution * rate);
+  const Softness& soft = limit.softness.isSet() ? limit.softness : *ctx.joint_softness;
+  const Real to_lower = s - limit.lower;  // >= 0 inside
+  const Real to_upper = limit.upper - s;  // >= 0 inside
+  if (limit.lower == limit.upper) {
+    // Locked: held from both sides, as ODE's and Bullet's limits do when
+    // lostop == histop, whether the row is rigid or a spring.
+    addRow(ctx, a, b, slot, j, to_lower, &limit.softness);
+  } else if (isSpring(soft)) {
+    // A soft stop is a spring-damper toward the bound it is past: the
+    // impulse may take either sign, so the damper brakes the return too
+    // (a one-sided row would clip that and let the joint spring back
+    // faster than the damped oscillator it stands for).
+    if (to_lower <= 0) addRow(ctx, a, b, slot, j, to_lower, &limit.softness);
+    else if (to_upper <= 0) addRow(ctx, a, b, slot, j, -to_upper, &limit.softness);
+  } else {
+    const Real rate = j.rate(a, b);
+    // Lower bound: the row may only push s up (lambda >= 0).
+    if (to_lower <= 0 || to_lower + ctx.h * rate < 0) {
+      const int i = addRow(ctx, a, b, slot, j, std::min(to_lower, Real(0)), &limit.softness, 0, kInf);
+      if (i >= 0) {
+        ConstraintRow& r = (*ctx.rows)[i];
+        if (to_lower > 0) speculate(r, -to_lower / ctx.h);  // close the gap, no more
+        if (limit.restitution > 0 && -rate > threshold) r.rhs = std::max(r.rhs, -limit.restitution * rate);
+      }
+    } else if (to_upper <= 0 || to_upper - ctx.h * rate < 0) {
+      const int i = addRow(ctx, a, b, slot, j, -std::min(to_upper, Real(0)), &limit.softness, -kInf, 0);
+      if (i >= 0) {
+        ConstraintRow& r = (*ctx.rows)[i];
+        if (to_upper > 0) speculate(r, to_upper / ctx.h);
+        if (limit.restitution > 0 && rate > threshold) r.rhs = std::min(r.rhs, -limit.restitution * rate);
+      }
     }
   }
   ctx.kind = saved;
 }
 
-void addMotorPart(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, Real target, Real max_force,
-                  const Vec3& lin_a, const Vec3& ang_a, const Vec3& lin_b, const Vec3& ang_b) {
+Softness servoSoftness(const Softness& motor_softness, Real effective_mass) {
+  Softness s = motor_softness;
+  if (!s.isSet()) {
+    s.frequency = 2;  // Jolt's MotorSettings default: 2 Hz, critically damped
+    s.damping_ratio = 1;
+  } else if (s.stiffness && !s.damping) {
+    s.damping = 2 * std::sqrt(*s.stiffness * effective_mass);  // critical: zeta = c / (2 sqrt(k m)) = 1
+  }
+  return s;
+}
+
+void addMotorPart(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, const MotorDef& motor, Real s,
+                  bool angular, const RowJacobian& j) {
   const RowKind saved = ctx.kind;
   ctx.kind = RowKind::Motor;
-  // A motor is a pure velocity row: rigid (no CFM), no position feedback.
-  static const Softness rigid{Real(0), Real(0), {}, {}, {}, {}};
-  const Real bound = max_force * ctx.h;
-  const int i = addRow(ctx, a, b, slot, lin_a, ang_a, lin_b, ang_b, 0, &rigid, -bound, bound);
-  if (i >= 0) (*ctx.rows)[i].rhs = target;
+  const Real bound = motor.max_force.value_or(0) * ctx.h;
+  if (motor.target_position) {
+    // Servo: the row is the implicit spring-damper of softness.hpp on the
+    // error s - target, rhs = -ERP/h (s - target), cfm = CFM/h.
+    const Real error = angular ? wrapAngle(s - *motor.target_position) : s - *motor.target_position;
+    const Softness soft = servoSoftness(motor.softness, effectiveMass(a, b, j));
+    addRow(ctx, a, b, slot, j, error, &soft, -bound, bound);
+  } else {
+    // Velocity motor: no position feedback; rigid (ERP 0, CFM 0) unless it
+    // has a damper, whose CFM = 1/c makes the force c (target - J v+).
+    static const Softness rigid{Real(0), Real(0), {}, {}, {}, {}};
+    const Softness* soft = motor.softness.isSet() ? &motor.softness : &rigid;
+    const int i = addRow(ctx, a, b, slot, j, 0, soft, -bound, bound);
+    if (i >= 0) (*ctx.rows)[i].rhs = motor.target_velocity;
+  }
   ctx.kind = saved;
 }
 
-Real angleAbout(const Vec3& axis, const Vec3& ref_a, const Vec3& ref_b) {
-  return std::atan2(ref_a.cross(ref_b).dot(axis), ref_a.dot(ref_b));
+Real angleAbout(const Vec3& axis, const Vec3& from, const Vec3& to) {
+  return std::atan2(from.cross(to).dot(axis), from.dot(to));
 }
 
 }  // namespace cairn

@@ -4,14 +4,18 @@
 //   two axis rows     d = p_b - p_a has no component along p or q,
 //                     the directions perpendicular to the slide axis
 //                     fixed in a: C = p.d, q.d                   (2 rows)
-//   limit             on s = ax.d, only at or past a bound       (0-1 row)
-//   motor             s' -> target, |lambda| <= max force h      (0-1 row)
+//   limit             on s = ax.(p_a - p_b), the travel of a relative
+//                     to b along the axis fixed in a (ODE's
+//                     dJointGetSliderPosition), only at or past a
+//                     bound                                      (0-1 row)
+//   motor             s' -> target_velocity or s -> target_position,
+//                     |lambda| <= max force h                    (0-1 row)
 #include "constraints/joint.hpp"
 
 namespace cairn {
 
 Real sliderPosition(const Joint& j, const BodyView& a, const BodyView& b) {
-  return worldVector(a, j.local_axis_a).dot(worldPoint(b, j.local_anchor_b) - worldPoint(a, j.local_anchor_a));
+  return worldVector(a, j.local_axis_a).dot(worldPoint(a, j.local_anchor_a) - worldPoint(b, j.local_anchor_b));
 }
 
 void buildSliderRows(const Joint& j, const BodyView& a, const BodyView& b, RowContext& ctx, const JointRowSettings& s) {
@@ -27,12 +31,11 @@ void buildSliderRows(const Joint& j, const BodyView& a, const BodyView& b, RowCo
   addAxisPart(ctx, a, b, 3, p, pa, pb, p.dot(d));
   addAxisPart(ctx, a, b, 4, q, pa, pb, q.dot(d));
 
-  // Rate of s = ax.d with ax fixed in a (the axis part's Jacobian).
-  const Vec3 lin_a = -ax, ang_a = -(pb - a.x).cross(ax), lin_b = ax, ang_b = (pb - b.x).cross(ax);
-  if (j.def.limit.enabled)
-    addLimitPart(ctx, a, b, 5, j.def.limit, ax.dot(d), lin_a, ang_a, lin_b, ang_b, s.restitution_threshold);
-  if (j.def.motor.enabled)
-    addMotorPart(ctx, a, b, 6, j.def.motor.target_velocity, j.def.motor.max_force, lin_a, ang_a, lin_b, ang_b);
+  if (!j.def.limit.enabled && !j.def.motor.enabled) return;
+  const Real travel = -ax.dot(d);
+  const RowJacobian rate = relativeTravel(a, b, ax, pa, pb, true);
+  addLimitPart(ctx, a, b, 5, j.def.limit, travel, rate, s.restitution_threshold);
+  if (j.def.motor.enabled && !locks(j.def.limit)) addMotorPart(ctx, a, b, 6, j.def.motor, travel, false, rate);
 }
 
 }  // namespace cairn

@@ -97,10 +97,27 @@ struct Body {
   Transform originTransform() const { return Transform{position - orientation * com_local, orientation}; }
 
   // Refresh R and R J^-1 R^T from the orientation.
+  //
+  // With rotation locks the angular velocity is w = B u, B an orthonormal
+  // basis of the allowed rotations (P = B B^T). The torque tau then moves
+  // u by B^T I B du/dt = B^T tau (the locks' reaction is along the locked
+  // axes, where B^T removes it), so the inverse inertia seen by forces and
+  // constraint rows is B (B^T I B)^-1 B^T, not P I^-1 P: the two differ
+  // when the world inertia I = R J R^T couples allowed and locked axes (a
+  // tilted box turning about a vertical axis turns at tau / I_zz, whereas
+  // P I^-1 P would give (I^-1)_zz tau). It is computed without building B:
+  // in the basis [B, N] the matrix P I P + s (1 - P) is block diagonal,
+  // diag(B^T I B, s), so P (P I P + s (1 - P))^-1 P = B (B^T I B)^-1 B^T
+  // for any s > 0; s = tr(I) / 3 keeps both blocks of the same size.
   void updateDerived() {
     rotation = orientation.toRotationMatrix();
     inv_inertia_world = rotation * inv_inertia_body * rotation.transpose();
-    if (rotation_locked) inv_inertia_world = rotation_projector * inv_inertia_world * rotation_projector;
+    if (rotation_locked && isDynamic()) {
+      const Mat3 inertia_world = rotation * inertia_body * rotation.transpose();
+      const Mat3& p = rotation_projector;
+      const Mat3 m = p * inertia_world * p + (inertia_world.trace() / 3) * (Mat3::Identity() - p);
+      inv_inertia_world = p * m.inverse() * p;
+    }
   }
 
   // The velocity the locks allow (their components removed).

@@ -92,6 +92,19 @@ Vec3 integrateVelocity(Body& b, const Vec3& gravity, Real h, Gyroscopic gyro, bo
   b.angular_velocity += h * (b.inv_inertia_world * b.torque);
 
   Vec3 orientation_offset = Vec3::Zero();
+  if (b.rotation_locked) {
+    // Rotation locks: the constrained Euler equation is
+    // B^T (I dw/dt + w x I w) = B^T tau (B a basis of the free rotations,
+    // dynamics/body.hpp), so the gyroscopic torque acts through the locked
+    // inverse inertia W = B (B^T I B)^-1 B^T, here explicitly. With one
+    // free axis a and w = u a its part along a, a . (a x I a) u^2, is zero:
+    // a planar body's spin is exact. The unconstrained schemes below would
+    // let the body wobble off the free axis and then lose that motion to
+    // the projection, changing the free spin.
+    if (gyro != Gyroscopic::Off)
+      b.angular_velocity -= h * (b.inv_inertia_world * b.angular_velocity.cross(b.angularMomentum()));
+    gyro = Gyroscopic::Off;
+  }
   switch (gyro) {
     case Gyroscopic::Off:
       break;
@@ -122,12 +135,8 @@ Vec3 integrateVelocity(Body& b, const Vec3& gravity, Real h, Gyroscopic gyro, bo
     }
   }
 
-  if (b.rotation_locked) {
-    // The gyroscopic term couples the axes; its part along a locked axis is
-    // taken by the lock (the projection is the lock's reaction).
-    b.angular_velocity = b.allowedAngular(b.angular_velocity);
-    orientation_offset = b.allowedAngular(orientation_offset);
-  }
+  // W's range is the free rotations; this removes only round-off.
+  if (b.rotation_locked) b.angular_velocity = b.allowedAngular(b.angular_velocity);
 
   // Linear damping as an implicit decay, stable for any h c.
   if (b.linear_damping > 0) b.linear_velocity /= (1 + h * b.linear_damping);

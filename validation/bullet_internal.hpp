@@ -11,6 +11,7 @@
 #include "cairn/settings.hpp"
 
 #include <btBulletDynamicsCommon.h>
+#include <BulletDynamics/ConstraintSolver/btGeneric6DofSpring2Constraint.h>
 
 #include <functional>
 #include <memory>
@@ -85,7 +86,8 @@ struct RowSoftness {
 // set, else the joint's, else the solver's global ERP and CFM.
 RowSoftness resolveRowSoftness(const Softness* axis, const Softness& joint, Real global_erp, Real global_cfm, Real h);
 
-enum class RowRole { Joint, Limit, Motor };
+// Spring: a 6-dof-2 spring row, whose CFM Bullet sets itself (0).
+enum class RowRole { Joint, Limit, Motor, Spring };
 
 struct CfmPlan {
   RowCfm joint, limit, motor;
@@ -145,5 +147,12 @@ struct JointContext {
 };
 
 BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b, const JointContext& ctx);
+
+// Axis limits, springs and motors of a six_dof joint on a 6-dof-2 built with
+// Bullet's A = cairn's b, B = cairn's a and both frames `frame` (columns x =
+// axis, y = axis2, z) at `anchor` (bullet_six_dof.cpp).
+void configureSixDof(CairnCfm<btGeneric6DofSpring2Constraint>& c, const JointDef& def, const Vec3& anchor,
+                     const Mat3& frame, const SolverSettings& s, Real h, bool match, std::vector<std::string>& notes,
+                     const std::string& who);
 
 }  // namespace cairn::validation::detail

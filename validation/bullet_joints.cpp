@@ -2,11 +2,13 @@
 //
 //   ball           btPoint2PointConstraint
 //   hinge          btHingeConstraint, frames z = axis, x = anyPerpendicular(axis);
-//                  useReferenceFrameA = true makes Bullet's hinge angle the
-//                  angle of b about +axis relative to a (cairn's hingeAngle)
+//                  useReferenceFrameA = false (Bullet's default) makes its
+//                  hinge angle and motor a's about +axis relative to b
+//                  (cairn's hingeAngle)
 //   slider         btSliderConstraint, frames x = axis, y = anyPerpendicular;
-//                  useLinearReferenceFrameA = true (position = axis.(p_b - p_a));
-//                  rotation about the axis locked (angular limits 0, 0)
+//                  useLinearReferenceFrameA = false (position = axis.(p_a - p_b),
+//                  cairn's sliderPosition); rotation about the axis locked
+//                  (angular limits 0, 0)
 //   fixed          btFixedConstraint (btGeneric6DofSpring2, all six locked)
 //   universal      btUniversalConstraint (axis on a = z, axis2 on b = y)
 //   cone_twist     btConeTwistConstraint, frames x = axis, y = anyPerpendicular
@@ -18,6 +20,12 @@
 //   distance       DistanceRow below: Bullet has no distance joint
 //   angular_motor  btGeneric6DofSpring2Constraint, everything free, motors
 //                  on its Euler axes (x = axis 1, z = axis 2, y = axis 3)
+//   six_dof        btGeneric6DofSpring2Constraint (RO_XYZ) with the bodies
+//                  swapped (Bullet's A = cairn's b): its translations are
+//                  then B's anchor in A's frame, cairn's a in b's, and its
+//                  Euler angles A relative to B, so x (twist) is the
+//                  innermost rotation as in cairn's swing-twist, and every
+//                  angle (and the linear motors' sense) is cairn's negated
 //
 // Bullet's joint rows (btSequentialImpulseConstraintSolver::convertJoint)
 // are never warm-started and ignore m_sor; their CFM is relative to the
@@ -129,6 +137,8 @@ class DistanceRow : public btTypedConstraint {
   bool has_erp_ = false, has_cfm_ = false;
 };
 
+bool isSpringSoftness(const Softness& s) { return s.stiffness || s.damping || s.frequency; }
+
 btTransform rotationAboutX(Real angle) {
   return btTransform(btQuaternion(btVector3(1, 0, 0), angle), btVector3(0, 0, 0));
 }
@@ -155,6 +165,7 @@ void applyCfmPlan(const btTypedConstraint& c, btTypedConstraint::btConstraintInf
   const int skip = info->rowskip;
   for (int r = 0; r < rows; ++r) {
     const RowRole role = plan.role ? plan.role(r) : RowRole::Joint;
+    if (role == RowRole::Spring) continue;
     const RowCfm& spec = role == RowRole::Joint ? plan.joint : role == RowRole::Limit ? plan.limit : plan.motor;
     Real cfm = spec.relative;
     if (spec.ode > 0) {
@@ -206,7 +217,19 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
   CfmPlan plan;
   plan.joint = joint_soft.cfm;
   plan.limit = limit_soft.cfm;
-  plan.motor = {0, 0};  // cairn's motors are rigid velocity rows
+  // cairn's velocity motors are rigid rows unless they have a damper.
+  plan.motor = def.motor.softness.isSet() && !def.motor.target_position
+                   ? resolveRowSoftness(&def.motor.softness, Softness{}, 0, 0, h).cfm
+                   : RowCfm{0, 0};
+  // A servo has no counterpart in Bullet's hinge and slider motors (they
+  // drive a speed); a soft limit is one-sided there.
+  const bool velocity_motor = def.motor.enabled && !def.motor.target_position;
+  if (def.motor.enabled && def.motor.target_position)
+    notes.push_back(who + ": position motor (target_position) not mapped: Bullet's " + jointTypeName(def.type) +
+                    " motor drives a velocity; left off");
+  if (def.limit.enabled && def.limit.lower < def.limit.upper &&
+      isSpringSoftness(def.limit.softness.isSet() ? def.limit.softness : def.softness))
+    notes.push_back(who + ": soft limit is a one-sided row in Bullet (cairn's pushes and pulls past the bound)");
   const auto adopt = [&](auto* c) {
     out.constraint.reset(c);
     if (match) {
@@ -225,7 +248,7 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
     }
     case JointType::Hinge: {
       const btTransform f = frameXY(def.anchor, ref, axis.cross(ref));  // z = axis
-      auto* c = adopt(new CairnCfm<btHingeConstraint>(*a.body, *b.body, ta_inv * f, tb_inv * f, true));
+      auto* c = adopt(new CairnCfm<btHingeConstraint>(*a.body, *b.body, ta_inv * f, tb_inv * f, false));
       if (own_erp) c->setParam(BT_CONSTRAINT_ERP, joint_soft.erp);
       if (def.limit.enabled) {
         if (match) {
@@ -239,7 +262,7 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
           c->setLimit(def.limit.lower, def.limit.upper);
         }
       }
-      if (def.motor.enabled) c->enableAngularMotor(true, def.motor.target_velocity, def.motor.max_force * h);
+      if (velocity_motor) c->enableAngularMotor(true, def.motor.target_velocity, *def.motor.max_force * h);
       if (match) {
         c->plan.role = [c](int row) {
           if (row < 5) return RowRole::Joint;
@@ -250,7 +273,7 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
     }
     case JointType::Slider: {
       const btTransform f = frameXY(def.anchor, axis, ref);  // x = axis
-      auto* c = adopt(new CairnCfm<btSliderConstraint>(*a.body, *b.body, ta_inv * f, tb_inv * f, true));
+      auto* c = adopt(new CairnCfm<btSliderConstraint>(*a.body, *b.body, ta_inv * f, tb_inv * f, false));
       c->setLowerAngLimit(0);  // rotation about the axis locked: cairn's slider has 5 rows
       c->setUpperAngLimit(0);
       if (match && own_erp) {
@@ -273,16 +296,17 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
             soft = std::sqrt(limit_soft.erp);
             c->setParam(BT_CONSTRAINT_STOP_ERP, soft, 0);
           }
-          c->setDampingLimLin(soft > 0 ? 1 - def.limit.restitution / soft : 1);
+          c->setDampingLimLin(1);  // no bounce: see below
           if (def.limit.restitution > 0)
             notes.push_back(who + ": limit restitution " + fmt(def.limit.restitution) +
-                            " applies at any approach speed in Bullet (no restitution threshold)");
+                            " not mapped (btSliderConstraint's linear bounce term pulls toward the stop "
+                            "with useLinearReferenceFrameA = false and never fires with true)");
         }
       }
-      if (def.motor.enabled) {
+      if (velocity_motor) {
         c->setPoweredLinMotor(true);
         c->setTargetLinMotorVelocity(def.motor.target_velocity);
-        c->setMaxLinMotorForce(def.motor.max_force);
+        c->setMaxLinMotorForce(*def.motor.max_force);
       }
       if (match) {
         c->plan.role = [c](int row) {
@@ -317,7 +341,9 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
       const btTransform f = frameXY(def.anchor, axis, ref);  // x = twist axis, y = cairn's reference axis
       const Real center = def.limit.enabled ? Real(0.5) * (def.limit.lower + def.limit.upper) : 0;
       const Real span = def.limit.enabled ? Real(0.5) * (def.limit.upper - def.limit.lower) : Real(BT_LARGE_FLOAT);
-      auto* c = adopt(new CairnCfm<btConeTwistConstraint>(*a.body, *b.body, ta_inv * f * rotationAboutX(center), tb_inv * f));
+      // Bullet's twist is A's relative to B (qAB = qB^-1 qA), as cairn's;
+      // turning frame A by -center makes its zero cairn's twist = center.
+      auto* c = adopt(new CairnCfm<btConeTwistConstraint>(*a.body, *b.body, ta_inv * f * rotationAboutX(-center), tb_inv * f));
       if (match) {
         c->setLimit(def.swing_span1, def.swing_span2, span, 1, limit_soft.erp, 1);
         if (own_erp)
@@ -359,15 +385,14 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
       c->setLinearUpperLimit(btVector3(-1, -1, -1));
       c->setAngularLowerLimit(btVector3(1, 1, 1));
       c->setAngularUpperLimit(btVector3(-1, -1, -1));
-      // 6-dof-2's Euler angles measure a relative to b, so its motors drive
-      // (w_a - w_b).axis toward the target: the sign is flipped for cairn's
-      // (w_b - w_a).axis.
+      // 6-dof-2's motors drive (w_a - w_b).axis toward the target, as
+      // cairn's angular motor does.
       const int index[3] = {3, 5, 4};
       const Vec3 frame_axis[3] = {x, z, y};
       for (size_t k = 0; k < n; ++k) {
         const Real sign = u[k].dot(frame_axis[k]) < 0 ? -1 : 1;
         c->enableMotor(index[k], true);
-        c->setTargetVelocity(index[k], -sign * def.motor_targets[k]);
+        c->setTargetVelocity(index[k], sign * def.motor_targets[k]);
         c->setMaxMotorForce(index[k], def.motor_max_torques[k]);
       }
       if (match) c->plan.role = [](int) { return RowRole::Motor; };
@@ -377,6 +402,20 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
                       " mapped to btGeneric6DofSpring2Constraint motors on its Euler axes (x = axis 1, z = axis 2, "
                       "y = axis 3), which stay on cairn's axes (fixed in a) only while b turns about them" +
                       (orthogonal ? "" : "; the axes are not orthogonal and were orthogonalized (targets approximate)"));
+      break;
+    }
+    case JointType::SixDof: {
+      Mat3 frame;
+      frame.col(0) = axis;
+      frame.col(1) = (def.axis2 - axis * axis.dot(def.axis2)).normalized();
+      frame.col(2) = axis.cross(frame.col(1));
+      const btTransform f = frameXY(def.anchor, frame.col(0), frame.col(1));
+      // Bullet's A is cairn's b (bullet_six_dof.cpp says why).
+      auto* c = adopt(new CairnCfm<btGeneric6DofSpring2Constraint>(*b.body, *a.body, tb_inv * f, ta_inv * f, RO_XYZ));
+      configureSixDof(*c, def, def.anchor, frame, s, h, match, notes, who);
+      const bool point = def.dofs[0].mode == DofMode::Locked && def.dofs[1].mode == DofMode::Locked &&
+                         def.dofs[2].mode == DofMode::Locked;
+      out.measure = point ? JointMeasure::Point : JointMeasure::None;
       break;
     }
   }
@@ -394,7 +433,8 @@ BuiltJoint buildJoint(const JointDef& def, const JointEnd& a, const JointEnd& b,
       case JointType::ConeTwist:
         for (int ax = 1; ax < 6; ++ax) c->setParam(BT_CONSTRAINT_STOP_CFM, joint_soft.cfm.ode, ax);
         break;
-      case JointType::AngularMotor: break;
+      case JointType::AngularMotor:
+      case JointType::SixDof: break;
     }
   }
 

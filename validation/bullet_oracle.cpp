@@ -142,6 +142,9 @@ struct BulletOracle::Impl {
     Vec3 x = Vec3::Zero();           // static and kinematic pose (cairn's terms)
     Quat q = Quat::Identity();
     Vec3 v = Vec3::Zero(), w = Vec3::Zero();  // kinematic scripted velocity
+    btVector3 force{0, 0, 0}, torque{0, 0, 0};    // BodyDef's constant loads
+    std::vector<BodyDef::TimedImpulse> impulses;  // by time
+    size_t next_impulse = 0;
   };
   struct JointRecord {
     std::string name;
@@ -210,6 +213,8 @@ struct BulletOracle::Impl {
   void configureSolver();
   void addBody(const Body& cb, const BodyDef& def, int index);
   btRigidBody* addRigidBody(const btRigidBody::btRigidBodyConstructionInfo& info, const BodyDef& def, int index);
+  void addLoadsAndLocks(BodyRecord& rec, const Body& cb, const std::string& who);
+  void applyImpulsesDue(Real now);
   void addJoint(const JointDef& def);
   void addSpring(const SpringDef& def);
   void holdSpringForces();
@@ -393,7 +398,42 @@ void BulletOracle::Impl::addBody(const Body& cb, const BodyDef& def, int index) 
     skipped.push_back(who + ": ccd approximated by Bullet's swept-sphere CCD (motion threshold and sphere radius " +
                       fmt(std::isfinite(r) ? r : 0) + " m)");
   }
+  if (cb.type == BodyType::Dynamic) addLoadsAndLocks(rec, cb, who);
   bodies.push_back(rec);
+}
+
+// Scripted loads: the constant force and torque are held like the springs'
+// forces, and each timed impulse is applied before the first step that
+// begins at or after its time, as cairn applies it. Locks: Bullet's linear
+// factor is cairn's (world axes, exact); its angular factor scales
+// J^-1 tau per world axis, which is cairn's exact constrained inverse
+// inertia only while the inertia does not couple free and locked axes, and
+// it cannot express a lock about an axis other than x, y or z.
+void BulletOracle::Impl::addLoadsAndLocks(BodyRecord& rec, const Body& cb, const std::string& who) {
+  rec.force = toBt(cb.constant_force);
+  rec.torque = toBt(cb.constant_torque);
+  rec.impulses = cb.impulses;
+  rec.rb->setLinearFactor(toBt(cb.linear_factor));
+  if (!cb.rotation_locked) return;
+  const Vec3 diag = cb.rotation_projector.diagonal();
+  if ((cb.rotation_projector - Mat3(diag.asDiagonal())).cwiseAbs().maxCoeff() > Real(1e-12)) {
+    skipped.push_back(who + ": lock_rotation about an axis other than x, y or z has no Bullet equivalent: not locked");
+    return;
+  }
+  rec.rb->setAngularFactor(toBt(diag));
+  skipped.push_back(who + ": lock_rotation approximated by Bullet's angular factor (J^-1 tau scaled per axis; "
+                          "cairn's exact constrained inertia agrees while the inertia couples no free and locked axis)");
+}
+
+void BulletOracle::Impl::applyImpulsesDue(Real now) {
+  for (BodyRecord& b : bodies) {
+    while (b.next_impulse < b.impulses.size() && b.impulses[b.next_impulse].time <= now) {
+      const BodyDef::TimedImpulse& imp = b.impulses[b.next_impulse++];
+      const btVector3 com = b.rb->getCenterOfMassPosition();
+      b.rb->applyImpulse(toBt(imp.impulse), imp.point ? toBt(*imp.point) - com : btVector3(0, 0, 0));
+      b.rb->activate(true);
+    }
+  }
 }
 
 void BulletOracle::Impl::addJoint(const JointDef& def) {
@@ -518,10 +558,16 @@ void BulletOracle::step() {
   Impl& m = *impl_;
   const auto t0 = std::chrono::steady_clock::now();
   m.holdSpringForces();
+  m.applyImpulsesDue(m.steps * m.dt + Real(1e-9) * m.dt);  // cairn's clock tolerance (world/step_integrate.cpp)
   for (int sub = 0; sub < m.substeps; ++sub) {
     for (const auto& f : m.held) {
       f.rb->applyCentralForce(f.force);
       f.rb->applyTorque(f.torque);
+    }
+    for (const auto& b : m.bodies) {
+      if (b.type != BodyType::Dynamic || (b.force.isZero() && b.torque.isZero())) continue;
+      b.rb->applyCentralForce(b.force);
+      b.rb->applyTorque(b.torque);
     }
     m.world->stepSimulation(m.h, 0);  // maxSubSteps = 0: exactly one internal step of h
     for (auto& b : m.bodies)

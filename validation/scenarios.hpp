@@ -26,7 +26,10 @@ SceneDesc pile(int per_side);                  // pile-N for N = per_side^3 (pil
 // table's common conditions itself (no sleeping).
 SceneDesc hingeChain(int links);               // hinge-chain: 5 planks on hinges, released from 0.3 rad
 SceneDesc door(Real max_torque);               // door: a box door on a vertical motorised hinge with limits
-SceneDesc ragdoll();                           // ragdoll: boxes and capsules, cone-twist and hinge joints, dropped
+SceneDesc ragdoll(bool six_dof);               // ragdoll: boxes and capsules, cone-twist and hinge joints (or
+                                               // ragdoll-6dof: six_dof joints), dropped
+SceneDesc motorLimits();                       // motor-limits: a hinge and a slider motor driving into asymmetric limits
+SceneDesc sixDof();                            // six-dof: a cube on a six_dof with one axis of each kind
 SceneDesc ramp();                              // ramp: boxes on 20 and 35 degree ramps, mu 0.5
 SceneDesc restitutionDrop(Real restitution);   // restitution-drop: a sphere of e dropped 2 m on the ground
 
@@ -36,6 +39,9 @@ SceneDesc restitutionDrop(Real restitution);   // restitution-drop: a sphere of 
 // of a whole cube of boxes). Throws InputError for an unknown key.
 SceneDesc byName(const std::string& key);
 std::vector<std::string> standardNames();
+
+// A dynamic body of one shape (friction 0.5, the BodyDef default).
+BodyDef solid(const std::string& name, Real mass, const Vec3& position, ShapeDesc shape);
 
 // Static ground: a box 200 x 1 x 200 m whose top face is y = 0 (Bullet
 // compares best with a box ground; a plane behaves the same in cairn).

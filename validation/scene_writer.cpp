@@ -132,6 +132,26 @@ Json bodyJson(const BodyDef& b) {
   Json shapes = Json::array();
   for (const ShapeDesc& s : b.shapes) shapes.push_back(shapeJson(s));
   j["shapes"] = shapes;
+  if (b.force != Vec3::Zero()) j["force"] = vec(b.force);
+  if (b.torque != Vec3::Zero()) j["torque"] = vec(b.torque);
+  if (!b.impulses.empty()) {
+    Json imps = Json::array();
+    for (const BodyDef::TimedImpulse& imp : b.impulses) {
+      Json i;
+      i["time"] = imp.time;
+      i["impulse"] = vec(imp.impulse);
+      if (imp.point) i["point"] = vec(*imp.point);
+      imps.push_back(i);
+    }
+    j["impulses"] = imps;
+  }
+  const auto axes = [](const std::vector<Vec3>& list) {
+    Json a = Json::array();
+    for (const Vec3& v : list) a.push_back(vec(v));
+    return a;
+  };
+  if (!b.lock_translation.empty()) j["lock_translation"] = axes(b.lock_translation);
+  if (!b.lock_rotation.empty()) j["lock_rotation"] = axes(b.lock_rotation);
   return j;
 }
 
@@ -148,6 +168,39 @@ void putSoftness(Json& j, const Softness& s) {
   if (s.damping_ratio) j["damping_ratio"] = *s.damping_ratio;
 }
 
+Json limitJson(const LimitDef& l) {
+  Json j;
+  j["lower"] = l.lower;
+  j["upper"] = l.upper;
+  if (l.restitution != 0) j["restitution"] = l.restitution;
+  putSoftness(j, l.softness);
+  return j;
+}
+
+Json motorJson(const MotorDef& m) {
+  Json j;
+  j["enabled"] = m.enabled;
+  if (m.target_position) j["target_position"] = *m.target_position;
+  else j["target_velocity"] = m.target_velocity;
+  if (m.max_force) j["max_force"] = *m.max_force;
+  putSoftness(j, m.softness);
+  return j;
+}
+
+Json dofJson(const DofDef& d) {
+  Json j;
+  j["mode"] = dofModeName(d.mode);
+  if (d.mode == DofMode::Limited) j["limits"] = limitJson(d.limit);
+  if (d.spring.enabled) {
+    Json s;
+    s["rest"] = d.spring.rest;
+    putSoftness(s, d.spring.softness);
+    j["spring"] = s;
+  }
+  if (d.motor.enabled) j["motor"] = motorJson(d.motor);
+  return j;
+}
+
 Json jointJson(const SceneDesc& scene, const JointDef& d) {
   const JointDef def;
   Json j;
@@ -162,14 +215,7 @@ Json jointJson(const SceneDesc& scene, const JointDef& d) {
   }
   if (d.axis != def.axis) j["axis"] = vec(d.axis);
   if (d.axis2 != def.axis2) j["axis2"] = vec(d.axis2);
-  if (d.limit.enabled) {
-    Json l;
-    l["lower"] = d.limit.lower;
-    l["upper"] = d.limit.upper;
-    if (d.limit.restitution != 0) l["restitution"] = d.limit.restitution;
-    putSoftness(l, d.limit.softness);
-    j["limits"] = l;
-  }
+  if (d.limit.enabled) j["limits"] = limitJson(d.limit);
   if (d.swing_span1 != def.swing_span1) j["swing_span1"] = d.swing_span1;
   if (d.swing_span2 != def.swing_span2) j["swing_span2"] = d.swing_span2;
   if (d.type == JointType::AngularMotor) {
@@ -181,10 +227,13 @@ Json jointJson(const SceneDesc& scene, const JointDef& d) {
                          {"max_force", i < d.motor_max_torques.size() ? d.motor_max_torques[i] : Real(0)}});
       j["motor"] = m;
     }
-  } else if (d.motor.enabled || d.motor.target_velocity != 0 || d.motor.max_force != 0) {
-    j["motor"] = Json{{"enabled", d.motor.enabled},
-                      {"target_velocity", d.motor.target_velocity},
-                      {"max_force", d.motor.max_force}};
+  } else if (d.motor.enabled || d.motor.target_velocity != 0 || d.motor.max_force || d.motor.target_position) {
+    j["motor"] = motorJson(d.motor);
+  }
+  if (d.type == JointType::SixDof) {
+    Json dofs;
+    for (int i = 0; i < kDofCount; ++i) dofs[dofName(i)] = dofJson(d.dofs[static_cast<size_t>(i)]);
+    j["dofs"] = dofs;
   }
   putSoftness(j, d.softness);
   if (std::isfinite(d.break_force)) j["break_force"] = d.break_force;

@@ -177,13 +177,45 @@ StandardScene standardScene(const std::string& key) {
     Json t = trace("door", "angle");
     t["axis"] = vec(Vec3::UnitY());
     v = block("door", ValidationKind::Trajectory, Json::array({t}), analytic);
-  } else if (key == "ragdoll") {
-    out.description = common + steps + ". A 15-part ragdoll (about 1.8 m, 56 kg; box pelvis and chest, capsule "
-                      "head and limbs; cone-twist neck, shoulders and hips, hinge spine, elbows and knees, all "
-                      "limited) laid face down 1 m above the ground and dropped. It lands, its limbs flop within "
-                      "their limits and it comes to rest lying on the ground with every joint together.";
+  } else if (key == "ragdoll" || key == "ragdoll-6dof") {
+    const std::string joints =
+        key == "ragdoll" ? "cone-twist neck, shoulders and hips, hinge spine, elbows and knees, all limited"
+                         : "six_dof joints with their translations locked and each rotation limited or locked as the "
+                           "body part allows; shoulders and hips swing up to 1.5 rad (86 degrees), the neck has a "
+                           "2 Hz spring";
+    out.description = common + steps + ". An 11-part ragdoll (about 1.8 m, 56 kg; box pelvis and chest, capsule "
+                      "head and limbs; " + joints + "; each joint lists the child first) laid face down 1 m above "
+                      "the ground and dropped. It lands, its limbs flop within their limits and it comes to rest "
+                      "lying on the ground with every joint together.";
     v = block("ragdoll", ValidationKind::Statistics, Json::array({trace("pelvis", "height"), trace("head", "height")}));
     v["top_body"] = "pelvis";
+  } else if (key == "motor-limits") {
+    const double inertia = 2 * (1 + 0.01) / 12 + 2 * 0.25;
+    // Accelerating at 2/I to 1.5 rad/s takes t1 = 1.5 I / 2 and turns
+    // 1.5 t1 / 2 rad, less than the 99% of 1.1 rad at which it is timed.
+    const double open99 = 0.99 * 1.1 / 1.5 + 1.5 * inertia / 2 / 2;
+    out.description = common + steps + ". Two motors driving into asymmetric limits, each body listed first so "
+                      "that targets and limits are its own motion. An arm (1 x 0.1 x 0.1 m, 2 kg) on a vertical hinge "
+                      "at its end, limits [-0.4, 1.1] rad, motor +1.5 rad/s with at most 2 N m: it accelerates at 2/I = " +
+                      fixed(2 / inertia, 3) + " rad/s^2 (I = " + fixed(inertia, 4) +
+                      " kg m^2), turns at 1.5 rad/s and stops on +1.1 rad (99% of the way after " + fixed(open99, 3) +
+                      " s). A cart (0.4 m cube, 1 kg) on a rail along x, limits [-0.3, 0.6] m, motor -0.4 m/s with "
+                      "at most 1 N: it accelerates at 1 m/s^2, slides at 0.4 m/s and stops on -0.3 m after 0.95 s.";
+    Json analytic = Json::array({Json{{"type", "open_time"}, {"body", "arm"}, {"axis", vec(Vec3::UnitY())},
+                                      {"angle", 1.1}, {"value", open99}}});
+    Json arm = trace("arm", "angle");
+    arm["axis"] = vec(Vec3::UnitY());
+    v = block("motor-limits", ValidationKind::Trajectory, Json::array({arm, trace("cart", "x")}), analytic);
+  } else if (key == "six-dof") {
+    out.description = common + steps + ". A 0.4 m cube of 2 kg held at its center by a six_dof joint to the world "
+                      "(cube listed first, frame = world axes), one axis of each kind: translation x free (it starts "
+                      "at 0.3 m/s), y limited to [-0.25, 0.1] m (it falls onto -0.25), z locked; rotation x a "
+                      "velocity motor (1 rad/s, at most 0.5 N m), y a spring (0.2 N m/rad, 0.02 N m s/rad; it starts "
+                      "turning at 0.3 rad/s), z limited to [-0.15, 0.3] rad (it starts turning at 0.5 rad/s and "
+                      "stops on 0.3).";
+    Json spin = trace("cube", "angle");
+    spin["axis"] = vec(Vec3::UnitX());
+    v = block("six-dof", ValidationKind::Trajectory, Json::array({trace("cube", "height"), trace("cube", "x"), spin}));
   } else if (key == "ramp") {
     const double g = 9.81, a35 = g * (std::sin(35 * kPi / 180) - 0.5 * std::cos(35 * kPi / 180));
     out.description = common + steps + ". Two 1 m boxes of 1 kg resting on static ramps, friction 0.5 "

@@ -164,6 +164,16 @@ ShapeDesc parseShape(const json& j, const std::string& object, const std::string
   return s;
 }
 
+// An array of [x, y, z] vectors (DOF lock axes); absent: none.
+std::vector<Vec3> vec3List(const Reader& r, const char* key) {
+  std::vector<Vec3> out;
+  if (!r.has(key)) return out;
+  const json& v = r.raw(key);
+  if (!v.is_array()) r.fail(key, "must be an array of [x, y, z] axes");
+  for (size_t i = 0; i < v.size(); ++i) out.push_back(r.vec3Of(v[i], std::string(key) + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
 BodyDef parseBody(const json& j, size_t index, const std::filesystem::path& base_dir) {
   std::string object = "body #" + std::to_string(index);
   if (j.is_object() && j.contains("name") && j["name"].is_string()) object = "body '" + j["name"].get<std::string>() + "'";
@@ -199,6 +209,25 @@ BodyDef parseBody(const json& j, size_t index, const std::filesystem::path& base
     for (size_t i = 0; i < shapes.size(); ++i)
       b.shapes.push_back(parseShape(shapes[i], object, "shapes[" + std::to_string(i) + "].", base_dir));
   }
+  b.force = r.vec3("force", Vec3::Zero());
+  b.torque = r.vec3("torque", Vec3::Zero());
+  if (r.has("impulses")) {
+    const json& imps = r.raw("impulses");
+    if (!imps.is_array()) r.fail("impulses", "must be an array of {time, impulse, point}");
+    for (size_t i = 0; i < imps.size(); ++i) {
+      Reader ir(imps[i], object, "impulses[" + std::to_string(i) + "].");
+      BodyDef::TimedImpulse imp;
+      if (!ir.has("time")) ir.fail("time", "missing: the time (s) the impulse is applied at");
+      if (!ir.has("impulse")) ir.fail("impulse", "missing: the impulse [x, y, z] (N s)");
+      imp.time = ir.number("time");
+      imp.impulse = ir.vec3("impulse");
+      if (ir.has("point")) imp.point = ir.vec3("point");
+      ir.finish();
+      b.impulses.push_back(imp);
+    }
+  }
+  b.lock_translation = vec3List(r, "lock_translation");
+  b.lock_rotation = vec3List(r, "lock_rotation");
   r.finish();
   return b;
 }
@@ -242,6 +271,42 @@ LimitDef parseLimit(const json& j, const std::string& object, const std::string&
   return l;
 }
 
+MotorDef parseMotor(const json& j, const std::string& object, const std::string& prefix) {
+  Reader m(j, object, prefix);
+  MotorDef d;
+  d.enabled = m.boolean("enabled", true);
+  d.target_position = m.optNumber("target_position");
+  if (!d.target_position && !m.has("target_velocity"))
+    m.fail("target_velocity", "missing: a motor needs target_velocity (a velocity motor) or target_position (a servo)");
+  d.target_velocity = m.number("target_velocity", 0);
+  d.max_force = m.optNumber("max_force");
+  d.softness = parseSoftness(m);
+  m.finish();
+  return d;
+}
+
+DofDef parseDof(const json& j, const std::string& object, const std::string& prefix) {
+  Reader r(j, object, prefix);
+  DofDef d;
+  const std::string mode = r.string("mode", "free");
+  if (mode == "free") d.mode = DofMode::Free;
+  else if (mode == "limited") d.mode = DofMode::Limited;
+  else if (mode == "locked") d.mode = DofMode::Locked;
+  else r.fail("mode", "must be free, limited or locked (got '" + mode + "')");
+  if (d.mode == DofMode::Limited && !r.has("limits")) r.fail("limits", "a limited axis needs limits {lower, upper}");
+  if (r.has("limits")) d.limit = parseLimit(r.raw("limits"), object, prefix + "limits.");
+  if (r.has("spring")) {
+    Reader sp(r.raw("spring"), object, prefix + "spring.");
+    d.spring.enabled = true;
+    d.spring.rest = sp.number("rest", 0);
+    d.spring.softness = parseSoftness(sp);
+    sp.finish();
+  }
+  if (r.has("motor")) d.motor = parseMotor(r.raw("motor"), object, prefix + "motor.");
+  r.finish();
+  return d;
+}
+
 JointType jointType(const Reader& r, const std::string& t) {
   if (t == "ball") return JointType::Ball;
   if (t == "hinge") return JointType::Hinge;
@@ -251,7 +316,9 @@ JointType jointType(const Reader& r, const std::string& t) {
   if (t == "cone_twist") return JointType::ConeTwist;
   if (t == "distance") return JointType::Distance;
   if (t == "angular_motor") return JointType::AngularMotor;
-  r.fail("type", "unknown joint type '" + t + "' (ball, hinge, slider, fixed, universal, cone_twist, distance, angular_motor)");
+  if (t == "six_dof") return JointType::SixDof;
+  r.fail("type", "unknown joint type '" + t +
+                     "' (ball, hinge, slider, fixed, universal, cone_twist, distance, angular_motor, six_dof)");
 }
 
 JointDef parseJoint(const json& j, size_t index, const SceneDesc& scene) {
@@ -290,12 +357,16 @@ JointDef parseJoint(const json& j, size_t index, const SceneDesc& scene) {
         m.finish();
       }
     } else {
-      Reader m(mj, object, "motor.");
-      d.motor.enabled = m.boolean("enabled", true);
-      d.motor.target_velocity = m.number("target_velocity");
-      d.motor.max_force = m.number("max_force");
-      m.finish();
+      d.motor = parseMotor(mj, object, "motor.");
     }
+  }
+  if (r.has("dofs")) {
+    if (d.type != JointType::SixDof) r.fail("dofs", "only a six_dof joint has dofs");
+    Reader dofs(r.raw("dofs"), object, "dofs.");
+    for (int i = 0; i < kDofCount; ++i)
+      if (dofs.has(dofName(i)))
+        d.dofs[static_cast<size_t>(i)] = parseDof(dofs.raw(dofName(i)), object, std::string("dofs.") + dofName(i) + ".");
+    dofs.finish();
   }
   d.softness = parseSoftness(r);
   d.break_force = r.number("break_force", kInf);

@@ -6,6 +6,7 @@
 #include "cairn/handles.hpp"
 #include "cairn/shape.hpp"
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -58,12 +59,13 @@ struct BodyDef {
 
   // Degrees of freedom locked by the mass matrix (Jolt's AllowedDOFs,
   // Bullet's linear and angular factors): world axes the body may neither
-  // translate along nor rotate about. The effective inverse mass and
-  // inertia are projected so that no impulse or force moves the body along
-  // them, exactly (no constraint rows that could stretch). Translation
-  // locks take the world axes x, y and z (unit vectors, either sign); a
-  // translation along any other line is a slider joint's job. Rotation
-  // locks take any non-zero world vectors.
+  // translate along nor rotate about. The inverse mass and inertia become
+  // the constrained body's (dynamics/body.hpp), so that no impulse or force
+  // moves the body along them, exactly (no constraint rows that could
+  // stretch), and torques about the free axes meet the right inertia.
+  // Translation locks take the world axes x, y and z (unit vectors, either
+  // sign); a translation along any other line is a slider joint's job.
+  // Rotation locks take any non-zero world vectors.
   std::vector<Vec3> lock_translation;
   std::vector<Vec3> lock_rotation;
 };
@@ -88,20 +90,63 @@ struct Softness {
   bool isSet() const { return erp || cfm || stiffness || damping || frequency || damping_ratio; }
 };
 
+// A limit on a joint coordinate s (hinge angle, slider travel, cone-twist
+// twist, a six_dof axis), all measured as body_a relative to body_b
+// (docs/constraints.md, "Sign conventions"). lower == upper holds the
+// coordinate there from both sides (a locked axis). A limit whose softness
+// is a spring (stiffness/damping or frequency/damping_ratio) is a soft
+// stop: past a bound it is a spring-damper toward that bound, pushing and
+// pulling, instead of a one-sided rigid row.
 struct LimitDef {
   bool enabled = false;
   Real lower = 0, upper = 0;  // rad for angular limits, m for linear ones
-  Real restitution = 0;
+  Real restitution = 0;       // rigid limits with lower < upper only
   Softness softness;
 };
 
+// A motor on a joint coordinate s (as for LimitDef: body_a relative to
+// body_b). A velocity motor drives ds/dt to target_velocity: rigid by
+// default, or through a damper (softness.damping, or ODE's softness.cfm)
+// for a soft velocity motor. A position motor (servo) drives s to
+// target_position through a spring-damper: softness stiffness/damping or
+// frequency/damping_ratio, critically damped at 2 Hz when unset (Jolt's
+// MotorSettings default) and critically damped when only a stiffness or a
+// frequency is given. Either way |force| <= max_force, which is required.
 struct MotorDef {
   bool enabled = false;
-  Real target_velocity = 0;  // rad/s or m/s
-  Real max_force = 0;        // N or N m; the row's bounds are +- max_force h
+  Real target_velocity = 0;            // rad/s or m/s
+  std::optional<Real> max_force;       // N or N m; the row's bounds are +- max_force h
+  std::optional<Real> target_position; // rad or m: a position motor
+  Softness softness;
 };
 
-enum class JointType { Ball, Hinge, Slider, Fixed, Universal, ConeTwist, Distance, AngularMotor };
+// One degree of freedom of a six_dof joint: free, limited (a LimitDef) or
+// locked (held at 0), with an optional spring toward `rest` and a motor.
+enum class DofMode { Free, Limited, Locked };
+
+const char* dofModeName(DofMode m);
+
+struct DofSpringDef {
+  bool enabled = false;
+  Real rest = 0;      // rad or m
+  Softness softness;  // stiffness/damping or frequency/damping_ratio
+};
+
+struct DofDef {
+  DofMode mode = DofMode::Free;
+  LimitDef limit;  // Limited: the range (enabled follows the mode)
+  DofSpringDef spring;
+  MotorDef motor;
+};
+
+// The six axes of a six_dof joint, in its frame (x = axis, y = axis2):
+// translations along x, y, z, then rotations about x (twist), y, z (swing).
+enum class Dof { TranslationX, TranslationY, TranslationZ, RotationX, RotationY, RotationZ };
+inline constexpr int kDofCount = 6;
+
+const char* dofName(int dof);  // "translation_x" ... "rotation_z"
+
+enum class JointType { Ball, Hinge, Slider, Fixed, Universal, ConeTwist, Distance, AngularMotor, SixDof };
 
 const char* jointTypeName(JointType t);
 
@@ -110,15 +155,17 @@ struct JointDef {
   JointType type = JointType::Ball;
   BodyId body_a = kWorldBody, body_b = kWorldBody;
   Vec3 anchor = Vec3::Zero();        // world frame at creation
-  Vec3 axis = Vec3::UnitZ();         // hinge/slider axis, cone-twist twist axis, universal axis on a
-  Vec3 axis2 = Vec3::UnitX();        // universal: axis on b
+  Vec3 axis = Vec3::UnitZ();         // hinge/slider axis, cone-twist twist axis, universal axis on a, six_dof x
+  Vec3 axis2 = Vec3::UnitX();        // universal: axis on b; six_dof: y (perpendicular to axis)
   Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();  // distance joint
   std::optional<Real> length;        // distance joint, default: the anchors' distance
   LimitDef limit;                    // hinge angle, slider distance, cone-twist twist
   Real swing_span1 = kPi, swing_span2 = kPi;  // cone-twist cone half-angles (rad)
   MotorDef motor;                    // hinge, slider
-  // Angular motor: target angular velocity of b relative to a on up to three
-  // world axes, each with its own maximum torque.
+  std::array<DofDef, kDofCount> dofs;  // six_dof
+  // Angular motor: target angular velocity of a relative to b on up to
+  // three axes (world at creation, then fixed in a), each with its own
+  // maximum torque.
   std::vector<Vec3> motor_axes;
   std::vector<Real> motor_targets;
   std::vector<Real> motor_max_torques;

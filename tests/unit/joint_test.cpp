@@ -130,9 +130,10 @@ TEST(BallChain, HorizontalWhipErrorFallsWithIterations) {
   }
 }
 
-// Hinge motor on a free-spinning wheel (solid cylinder about its axis):
-// with enough torque it reaches the target speed; with too little it
-// accelerates at exactly tau / I (the motor row saturates at tau h).
+// Hinge motor on a free-spinning wheel (solid cylinder about its axis),
+// listed first so that the motor turns it at +target: with enough torque it
+// reaches the target speed; with too little it accelerates at exactly
+// tau / I (the motor row saturates at tau h).
 TEST(HingeMotor, ReachesTargetOrAcceleratesAtTorqueOverInertia) {
   const auto run = [](Real max_torque, int steps) {
     World w(Vec3::Zero());
@@ -144,8 +145,8 @@ TEST(HingeMotor, ReachesTargetOrAcceleratesAtTorqueOverInertia) {
     const BodyId id = w.createBody(d);
     JointDef j;
     j.type = JointType::Hinge;
-    j.body_a = kWorldBody;
-    j.body_b = id;
+    j.body_a = id;
+    j.body_b = kWorldBody;
     j.axis = Vec3::UnitZ();
     j.motor.enabled = true;
     j.motor.target_velocity = 10;
@@ -185,15 +186,15 @@ TEST(HingeLimit, PendulumStaysInsideItsLimits) {
   EXPECT_NEAR(lowest, -0.5, 0.01);  // it reached the bound and stopped there
 }
 
-// Slider with limits: a box on a horizontal slider pushed by gravity along
-// a tilted axis stops at the upper limit.
+// Slider with limits: a box (listed first, so the travel is its own) on a
+// slider pushed by gravity along a tilted axis stops at the upper limit.
 TEST(SliderLimit, StopsAtTheBoundAndKeepsOrientation) {
   World w;
   const BodyId id = w.createBody(test::boxDef("carriage", Vec3::Zero(), 1, Vec3(0.2, 0.1, 0.1)));
   JointDef j;
   j.type = JointType::Slider;
-  j.body_a = kWorldBody;
-  j.body_b = id;
+  j.body_a = id;
+  j.body_b = kWorldBody;
   j.axis = Vec3(1, -1, 0).normalized();
   j.limit.enabled = true;
   j.limit.lower = -1;
@@ -397,14 +398,15 @@ TEST(ConeTwist, SwingStaysInsideTheCone) {
   EXPECT_LT(w.jointError(jid).linear, 0.01);
 }
 
-// Angular motor on three axes spins a free box up to the target vector.
+// Angular motor on three axes spins a free box (listed first) up to the
+// target vector.
 TEST(AngularMotor, DrivesAllThreeAxesToTarget) {
   World w(Vec3::Zero());
   const BodyId id = w.createBody(test::boxDef("box", Vec3::Zero()));
   JointDef j;
   j.type = JointType::AngularMotor;
-  j.body_a = kWorldBody;
-  j.body_b = id;
+  j.body_a = id;
+  j.body_b = kWorldBody;
   j.motor_axes = {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
   j.motor_targets = {1, -2, 0.5};
   j.motor_max_torques = {100, 100, 100};

@@ -38,10 +38,35 @@ TEST(SceneFile, ValidSceneLoadsAndBuilds) {
   EXPECT_DOUBLE_EQ(cairn::detail::internals(w).body(BodyId{1}).mass, 2);
 }
 
+// Motors, limits and a six_dof joint with one axis of each kind.
+const char* kValidJoints = R"({
+  "bodies": [
+    {"name": "arm", "mass": 1, "shapes": [{"type": "box", "half_extents": [0.5, 0.1, 0.1]}]},
+    {"name": "cart", "mass": 1, "position": [3, 0, 0], "shapes": [{"type": "box", "half_extents": [0.2, 0.2, 0.2]}]},
+    {"name": "puck", "mass": 1, "position": [6, 0, 0], "shapes": [{"type": "sphere", "radius": 0.2}]}
+  ],
+  "joints": [
+    {"name": "servo", "type": "hinge", "bodies": ["arm", "world"], "axis": [0, 0, 1],
+     "limits": {"lower": -0.5, "upper": 1.2, "restitution": 0.3},
+     "motor": {"target_position": 0.8, "max_force": 4, "frequency": 2, "damping_ratio": 1}},
+    {"name": "rail", "type": "slider", "bodies": ["cart", "world"], "anchor": [3, 0, 0], "axis": [1, 0, 0],
+     "limits": {"lower": 0.1, "upper": 0.1, "stiffness": 100, "damping": 2},
+     "motor": {"target_velocity": 0.5, "max_force": 20, "damping": 10}},
+    {"name": "six", "type": "six_dof", "bodies": ["puck", "world"], "anchor": [6, 0, 0],
+     "axis": [1, 0, 0], "axis2": [0, 1, 0],
+     "dofs": {"translation_x": {"mode": "free"},
+              "translation_y": {"mode": "limited", "limits": {"lower": -0.2, "upper": 0.1}},
+              "translation_z": {"mode": "locked"},
+              "rotation_x": {"motor": {"target_velocity": 2, "max_force": 3}},
+              "rotation_y": {"spring": {"rest": 0.1, "stiffness": 50, "damping": 1}},
+              "rotation_z": {"mode": "limited", "limits": {"lower": -0.3, "upper": 1.4}}}}
+  ]
+})";
+
 // Replaces the first occurrence of `from` in the valid scene by `to`, parses,
 // and returns the error message ("" if it parsed).
-std::string errorFor(const std::string& from, const std::string& to) {
-  std::string text = kValid;
+std::string errorFor(const std::string& from, const std::string& to, const char* base = kValid) {
+  std::string text = base;
   const auto pos = text.find(from);
   EXPECT_NE(pos, std::string::npos) << from;
   text.replace(pos, from.size(), to);
@@ -53,8 +78,9 @@ std::string errorFor(const std::string& from, const std::string& to) {
   return "";
 }
 
-void expectError(const std::string& from, const std::string& to, const std::string& object, const std::string& field) {
-  const std::string msg = errorFor(from, to);
+void expectError(const std::string& from, const std::string& to, const std::string& object, const std::string& field,
+                 const char* base = kValid) {
+  const std::string msg = errorFor(from, to, base);
   EXPECT_NE(msg.find("scene.json"), std::string::npos) << msg;
   EXPECT_NE(msg.find(object), std::string::npos) << "object '" << object << "' missing in: " << msg;
   EXPECT_NE(msg.find(field), std::string::npos) << "field '" << field << "' missing in: " << msg;
@@ -124,6 +150,70 @@ TEST(SceneFile, EachBadJointInputNamesObjectAndField) {
   expectError("\"axis\": [0, 0, 1],", "\"axis\": [0, 0, 1], \"erp\": 1.5,", "joint 'h'", "erp");
   expectError("\"axis\": [0, 0, 1],", "\"axis\": [0, 0, 1], \"cfm\": -1,", "joint 'h'", "cfm");
   expectError("\"type\": \"hinge\"", "\"type\": \"hing\"", "joint 'h'", "type");
+}
+
+TEST(SceneFile, MotorsLimitsAndSixDofLoadAndBuild) {
+  const SceneDesc s = parseScene(kValidJoints, "joints.json");
+  ASSERT_EQ(s.joints.size(), 3u);
+  EXPECT_EQ(s.joints[0].motor.target_position, 0.8);
+  EXPECT_EQ(s.joints[1].motor.softness.damping, 10);
+  const JointDef& six = s.joints[2];
+  EXPECT_EQ(six.type, JointType::SixDof);
+  EXPECT_EQ(six.dofs[1].mode, DofMode::Limited);
+  EXPECT_EQ(six.dofs[1].limit.lower, -0.2);
+  EXPECT_EQ(six.dofs[2].mode, DofMode::Locked);
+  EXPECT_TRUE(six.dofs[3].motor.enabled);
+  EXPECT_TRUE(six.dofs[4].spring.enabled);
+  EXPECT_EQ(six.dofs[4].spring.rest, 0.1);
+  World w = buildWorld(s);
+  for (int k = 0; k < 10; ++k) w.step(1.0 / 60);
+  EXPECT_TRUE(w.numericalEvents().empty());
+}
+
+TEST(SceneFile, EachBadMotorLimitAndSixDofInputNamesObjectAndField) {
+  const auto bad = [](const std::string& from, const std::string& to, const std::string& object,
+                      const std::string& field) { expectError(from, to, object, field, kValidJoints); };
+  // Limits.
+  bad(R"("lower": -0.5, "upper": 1.2)", R"("lower": 1.3, "upper": 1.2)", "joint 'servo'", "limits.lower");
+  bad(R"("lower": -0.5, "upper": 1.2)", R"("lower": -4, "upper": 1.2)", "joint 'servo'", "limits.lower");
+  bad(R"("stiffness": 100, "damping": 2})", R"("stiffness": 100, "damping": -2})", "joint 'rail'", "limits.damping");
+  bad(R"("stiffness": 100, "damping": 2})", R"("frequency": -1})", "joint 'rail'", "limits.frequency");
+  bad(R"("upper": 0.1, "stiffness")", R"("upper": 0.1, "restitution": 0.5, "stiffness")", "joint 'rail'",
+      "limits.restitution");
+  bad(R"("upper": 1.2, "restitution": 0.3})", R"("upper": 1.2, "restitution": 0.3, "stiffness": 10})",
+      "joint 'servo'", "limits.restitution");
+  // Motors.
+  bad(R"("max_force": 4, )", "", "joint 'servo'", "motor.max_force");
+  bad(R"("target_position": 0.8, )", "", "joint 'servo'", "motor.target_velocity");
+  bad(R"("target_position": 0.8,)", R"("target_position": 0.8, "target_velocity": 1,)", "joint 'servo'",
+      "motor.target_velocity");
+  bad(R"("frequency": 2, "damping_ratio": 1})", R"("frequency": -2})", "joint 'servo'", "motor.frequency");
+  bad(R"("frequency": 2, "damping_ratio": 1})", R"("erp": 0.5})", "joint 'servo'", "motor.erp");
+  bad(R"("frequency": 2, "damping_ratio": 1})", R"("damping": 3})", "joint 'servo'", "motor.damping");
+  bad(R"("max_force": 20, "damping": 10)", R"("max_force": 20, "stiffness": 10)", "joint 'rail'", "motor.stiffness");
+  bad(R"("max_force": 20, "damping": 10)", R"("max_force": 20, "damping": -10)", "joint 'rail'", "motor.damping");
+  // six_dof.
+  bad(R"({"mode": "free"})", R"({"mode": "loose"})", "joint 'six'", "dofs.translation_x.mode");
+  bad(R"({"mode": "free"})", R"({"mode": "free", "limits": {"lower": 0, "upper": 1}})", "joint 'six'",
+      "dofs.translation_x.limits");
+  bad(R"({"mode": "locked"})", R"({"mode": "limited"})", "joint 'six'", "dofs.translation_z.limits");
+  bad(R"("lower": -0.2, "upper": 0.1)", R"("lower": 0.2, "upper": 0.1)", "joint 'six'",
+      "dofs.translation_y.limits.lower");
+  bad(R"("lower": -0.3, "upper": 1.4)", R"("lower": -0.3, "upper": 3.5)", "joint 'six'",
+      "dofs.rotation_z.limits.upper");
+  bad(R"("target_velocity": 2, "max_force": 3)", R"("target_velocity": 2)", "joint 'six'",
+      "dofs.rotation_x.motor.max_force");
+  bad(R"("rest": 0.1, "stiffness": 50, "damping": 1)", R"("rest": 0.1, "damping": 1)", "joint 'six'",
+      "dofs.rotation_y.spring.stiffness");
+  bad(R"("rest": 0.1, "stiffness": 50, "damping": 1)", R"("rest": 0.1, "frequency": -1)", "joint 'six'",
+      "dofs.rotation_y.spring.frequency");
+  bad(R"("rest": 0.1,)", R"("rest": 4,)", "joint 'six'", "dofs.rotation_y.spring.rest");
+  bad(R"("rotation_x":)", R"("rotation_w":)", "joint 'six'", "dofs.rotation_w");
+  bad(R"("axis2": [0, 1, 0])", R"("axis2": [1, 0.5, 0])", "joint 'six'", "axis2");
+  bad(R"("type": "six_dof")", R"("type": "ball")", "joint 'six'", "dofs");
+  // Limits and motors only where the type has them.
+  bad(R"("axis": [1, 0, 0], "axis2")", R"("axis": [1, 0, 0], "motor": {"target_velocity": 1, "max_force": 1}, "axis2")",
+      "joint 'six'", "motor");
 }
 
 TEST(SceneFile, PlaneOnADynamicBodyIsRejected) {

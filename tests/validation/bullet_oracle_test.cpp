@@ -31,12 +31,7 @@ SceneDesc emptyScene(const Vec3& gravity = Vec3(0, -kG, 0)) {
 }
 
 BodyDef dynamicBody(const std::string& name, const Vec3& pos, ShapeDesc shape, Real mass = 1) {
-  BodyDef d;
-  d.name = name;
-  d.mass = mass;
-  d.position = pos;
-  d.shapes.push_back(std::move(shape));
-  return d;
+  return scenarios::solid(name, mass, pos, std::move(shape));
 }
 
 BodyDef box(const std::string& name, const Vec3& pos, Real mass = 1, const Vec3& he = Vec3(0.5, 0.5, 0.5)) {
@@ -114,6 +109,39 @@ TEST(BulletOracle, DampingMatchesCairnsPerStepFactor) {
   EXPECT_NEAR(oracle.state(0).linear_velocity.x(), 2 / std::pow(1 + kH * 0.5, 60), 1e-12);
   EXPECT_NEAR(oracle.state(0).angular_velocity.z(), 3 / std::pow(1 + kH * 1.0, 60), 1e-12);
   EXPECT_TRUE(mentions(oracle.skipped(), "damping approximated"));
+}
+
+// A body's scripted loads reach Bullet as cairn applies them: a constant
+// force and a torque on a sphere in zero gravity give x_n = x0 +
+// h^2 (F/m) n(n+1)/2 and w_n = n h tau / I (the sphere has no gyroscopic
+// term) in both engines, and a timed impulse at 0.5 s lands in the same
+// step; a translation lock (Bullet's linear factor) keeps the pushed body
+// on its plane. Tolerances as in the free fall above.
+TEST(BulletOracle, ScriptedLoadsAndTranslationLocksMatchCairn) {
+  SceneDesc scene = emptyScene(Vec3::Zero());
+  BodyDef ball = dynamicBody("ball", Vec3(1, 2, 3), ShapeDesc::sphere(0.5), 2);
+  ball.force = Vec3(3, -1, 0.5);
+  ball.torque = Vec3(0, 0.2, -0.1);
+  ball.impulses = {{0.5, Vec3(0, 0, 4), std::nullopt}};
+  ball.lock_translation = {Vec3::UnitY()};
+  scene.bodies.push_back(ball);
+  BulletOracle oracle(scene);
+  World world = buildWorld(scene);
+  const BodyId id = world.findBody("ball");
+  const Real inertia = Real(0.4) * 2 * 0.25;  // 2/5 m r^2
+  const Vec3 x0 = oracle.state(0).position;
+  const Vec3 a = ball.force.cwiseProduct(Vec3(1, 0, 1)) / 2;  // y locked
+  for (int n = 1; n <= 60; ++n) {
+    oracle.step();
+    world.step(kH);
+    // The impulse acts from the step starting at 0.5 s (step 31): its
+    // velocity p/m has moved the ball for n - 30 steps.
+    const Vec3 kick = n > 30 ? Vec3((n - 30) * kH * ball.impulses[0].impulse / 2) : Vec3::Zero();
+    const Vec3 expected_x = x0 + kH * kH * a * (n * (n + 1) / 2.0) + kick;
+    ASSERT_LT((oracle.state(0).position - expected_x).norm(), 1e-9) << "step " << n;
+    ASSERT_LT((world.centerOfMass(id) - expected_x).norm(), 1e-9) << "step " << n;
+    ASSERT_LT((oracle.state(0).angular_velocity - n * kH * ball.torque / inertia).norm(), 1e-9) << "step " << n;
+  }
 }
 
 // A body whose inertia is not diagonal in its own frame: Bullet gets it in
@@ -438,7 +466,7 @@ TEST(BulletOracle, EveryJointTypeBuildsAndHolds) {
   const BodyId spinner = add("b7", Vec3(18, 0, 0));
   JointDef* hold = joint(JointType::Ball, "hold", kWorldBody, spinner, Vec3(18, 0, 0));
   (void)hold;
-  JointDef* motor = joint(JointType::AngularMotor, "motor", kWorldBody, spinner, Vec3::Zero());
+  JointDef* motor = joint(JointType::AngularMotor, "motor", spinner, kWorldBody, Vec3::Zero());
   motor->motor_axes = {Vec3(0, 0, 1)};
   motor->motor_targets = {1};
   motor->motor_max_torques = {10};
@@ -461,60 +489,73 @@ TEST(BulletOracle, EveryJointTypeBuildsAndHolds) {
   EXPECT_TRUE(mentions(oracle.skipped(), "joint 'distance' (distance): Bullet has no distance joint"));
 }
 
-// Sign conventions: cairn's motors drive the rate of b relative to a about
-// (along) +axis. With no gravity and the anchor at the center of mass the
-// motor row is decoupled from the others, so the body reaches the target to
-// the solver's precision within one step.
-TEST(BulletOracle, MotorsDriveTheCairnDirection) {
+// Sign conventions: cairn's motors drive the rate of a (the first body)
+// relative to b about (along) +axis, as ODE's and Bullet's do. With no
+// gravity and the anchor at the center of mass the motor row is decoupled
+// from the others, so the body reaches the target to the solver's
+// precision within one step. The last hinge lists the world first: the
+// body then turns at -target.
+TEST(BulletOracle, MotorsDriveTheFirstBodyRelativeToTheSecond) {
   SceneDesc scene = emptyScene(Vec3::Zero());
   scene.bodies.push_back(box("hinged", Vec3(0, 0, 0)));
   scene.bodies.push_back(box("sliding", Vec3(5, 0, 0)));
   scene.bodies.push_back(box("spun", Vec3(10, 0, 0)));
   scene.bodies.push_back(box("rolled", Vec3(15, 0, 0)));
+  scene.bodies.push_back(box("second", Vec3(20, 0, 0)));
   JointDef hinge;
   hinge.name = "hinge";
   hinge.type = JointType::Hinge;
-  hinge.body_b = BodyId{0};
+  hinge.body_a = BodyId{0};
+  hinge.body_b = kWorldBody;
   hinge.axis = Vec3(0, 0, 1);
-  hinge.motor = MotorDef{true, 2, 100};
+  hinge.motor = MotorDef{true, 2, 100, {}, {}};
   JointDef slider;
   slider.name = "slider";
   slider.type = JointType::Slider;
-  slider.body_b = BodyId{1};
+  slider.body_a = BodyId{1};
+  slider.body_b = kWorldBody;
   slider.anchor = Vec3(5, 0, 0);
   slider.axis = Vec3(1, 0, 0);
-  slider.motor = MotorDef{true, 0.5, 100};
+  slider.motor = MotorDef{true, 0.5, 100, {}, {}};
   // Angular motors: one axis, and two axes of which only the first turns
-  // (the second holds zero), so that b turns about the motor axes and
-  // Bullet's Euler axes stay on cairn's.
+  // (the second holds zero), so that the body turns about the motor axes
+  // and Bullet's Euler axes stay on cairn's.
   JointDef spin;
   spin.name = "spin";
   spin.type = JointType::AngularMotor;
-  spin.body_b = BodyId{2};
+  spin.body_a = BodyId{2};
+  spin.body_b = kWorldBody;
   spin.motor_axes = {Vec3(0, 1, 0)};
   spin.motor_targets = {1.5};
   spin.motor_max_torques = {100};
   JointDef roll = spin;
   roll.name = "roll";
-  roll.body_b = BodyId{3};
+  roll.body_a = BodyId{3};
   roll.motor_axes = {Vec3(1, 0, 0), Vec3(0, 0, -1)};
   roll.motor_targets = {-0.5, 0};
   roll.motor_max_torques = {100, 100};
-  scene.joints = {hinge, slider, spin, roll};
+  JointDef reversed = hinge;
+  reversed.name = "reversed";
+  reversed.body_a = kWorldBody;
+  reversed.body_b = BodyId{4};
+  reversed.anchor = Vec3(20, 0, 0);
+  scene.joints = {hinge, slider, spin, roll, reversed};
   BulletOracle oracle(scene);
   for (int n = 0; n < 30; ++n) oracle.step();
   EXPECT_NEAR(oracle.state(0).angular_velocity.z(), 2, 1e-6);
   EXPECT_NEAR(oracle.state(1).linear_velocity.x(), 0.5, 1e-6);
   EXPECT_LT((oracle.state(2).angular_velocity - Vec3(0, 1.5, 0)).norm(), 1e-6);
   EXPECT_LT((oracle.state(3).angular_velocity - Vec3(-0.5, 0, 0)).norm(), 1e-6);
+  EXPECT_NEAR(oracle.state(4).angular_velocity.z(), -2, 1e-6);
 }
 
-// Limits in cairn's terms: the hinge angle of b about +axis within
-// [-0.2, 0.3]; the cone-twist twist within the asymmetric [-0.1, 0.4], which
-// Bullet can only express as a symmetric span about a turned frame. The body
-// is thrown against each stop with no gravity; Bullet's limit rows engage
-// only past the stop, so allow one step of travel (1 rad/s x h) plus
-// Baumgarte slack: 0.03 rad.
+// Limits in cairn's terms: the hinge angle of the body (listed first) about
+// +axis within [-0.2, 0.3]; the cone-twist twist within the asymmetric
+// [-0.1, 0.4], which Bullet can only express as a symmetric span about a
+// turned frame; the slider travel within [-0.25, 0.15]. Each body is thrown
+// against its stops with no gravity; Bullet's limit rows engage only past
+// the stop, so allow one step of travel (1 rad/s or m/s x h) plus Baumgarte
+// slack: 0.03.
 TEST(BulletOracle, LimitsHoldCairnsRanges) {
   for (const Real w : {1.0, -1.0}) {
     SceneDesc scene = emptyScene(Vec3::Zero());
@@ -522,44 +563,129 @@ TEST(BulletOracle, LimitsHoldCairnsRanges) {
     hinged.angular_velocity = Vec3(0, 0, w);
     BodyDef twisted = box("twisted", Vec3(5, 0, 0));
     twisted.angular_velocity = Vec3(w, 0, 0);
-    scene.bodies = {hinged, twisted};
-    JointDef hinge;
-    hinge.name = "hinge";
-    hinge.type = JointType::Hinge;
-    hinge.body_b = BodyId{0};
-    hinge.axis = Vec3(0, 0, 1);
-    hinge.limit.enabled = true;
-    hinge.limit.lower = -0.2;
-    hinge.limit.upper = 0.3;
-    JointDef cone;
-    cone.name = "cone";
-    cone.type = JointType::ConeTwist;
-    cone.body_b = BodyId{1};
-    cone.anchor = Vec3(5, 0, 0);
-    cone.axis = Vec3(1, 0, 0);
-    cone.limit.enabled = true;
-    cone.limit.lower = -0.1;
-    cone.limit.upper = 0.4;
-    scene.joints = {hinge, cone};
+    BodyDef slid = box("slid", Vec3(10, 0, 0));
+    slid.linear_velocity = Vec3(w, 0, 0);
+    scene.bodies = {hinged, twisted, slid};
+    const auto limited = [](JointType type, int body, const Vec3& anchor, const Vec3& axis, Real lower, Real upper) {
+      JointDef j;
+      j.name = jointTypeName(type);
+      j.type = type;
+      j.body_a = BodyId{body};
+      j.body_b = kWorldBody;
+      j.anchor = anchor;
+      j.axis = axis;
+      j.limit = LimitDef{true, lower, upper, 0, {}};
+      return j;
+    };
+    const JointDef hinge = limited(JointType::Hinge, 0, Vec3::Zero(), Vec3::UnitZ(), -0.2, 0.3);
+    const JointDef cone = limited(JointType::ConeTwist, 1, Vec3(5, 0, 0), Vec3::UnitX(), -0.1, 0.4);
+    const JointDef slider = limited(JointType::Slider, 2, Vec3(10, 0, 0), Vec3::UnitX(), -0.25, 0.15);
+    scene.joints = {hinge, cone, slider};
     BulletOracle oracle(scene);
-    Real hinge_min = 0, hinge_max = 0, twist_min = 0, twist_max = 0;
+    Real lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int n = 0; n < 90; ++n) {
       oracle.step();
-      const Real a = angleAbout(oracle.state(0).orientation, Vec3::UnitZ());
-      const Real t = angleAbout(oracle.state(1).orientation, Vec3::UnitX());
-      hinge_min = std::min(hinge_min, a);
-      hinge_max = std::max(hinge_max, a);
-      twist_min = std::min(twist_min, t);
-      twist_max = std::max(twist_max, t);
+      const Real c[3] = {angleAbout(oracle.state(0).orientation, Vec3::UnitZ()),
+                         angleAbout(oracle.state(1).orientation, Vec3::UnitX()), oracle.state(2).position.x() - 10};
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], c[k]);
+        hi[k] = std::max(hi[k], c[k]);
+      }
     }
     SCOPED_TRACE(w);
     if (w > 0) {
-      EXPECT_NEAR(hinge_max, 0.3, 0.03);
-      EXPECT_NEAR(twist_max, 0.4, 0.03);
+      EXPECT_NEAR(hi[0], 0.3, 0.03);
+      EXPECT_NEAR(hi[1], 0.4, 0.03);
+      EXPECT_NEAR(hi[2], 0.15, 0.03);
     } else {
-      EXPECT_NEAR(hinge_min, -0.2, 0.03);
-      EXPECT_NEAR(twist_min, -0.1, 0.03);
+      EXPECT_NEAR(lo[0], -0.2, 0.03);
+      EXPECT_NEAR(lo[1], -0.1, 0.03);
+      EXPECT_NEAR(lo[2], -0.25, 0.03);
     }
+  }
+}
+
+// six_dof in cairn's terms on Bullet's 6-dof-2 (built with the bodies
+// swapped, bullet_six_dof.cpp): each cube is listed first, its frame the
+// world's axes, everything locked but the axes under test.
+//  - velocity motors on translation x and the twist drive the cube at
+//    +0.5 m/s and +1 rad/s (decoupled rows: to the solver's precision);
+//  - limits translation y in [-0.25, 0.15], rotation z in [-0.2, 0.3] stop
+//    a cube thrown at +-1 m/s and rad/s at the bound it heads for: 6-dof-2
+//    sets a limit row's target to the bounce, 0 here, once the joint would
+//    cross within the step, so it stops up to a step's travel short
+//    (h x 1 = 0.017; 0.02);
+//  - springs toward rest points 0.1 m (translation y, under gravity) and
+//    0.3 rad (rotation z) settle where cairn's do: rest - m g / k and 0.3
+//    (damped 3 s; 1e-3).
+TEST(BulletOracle, SixDofAxesFollowCairnsSigns) {
+  const auto cube = [](const std::string& name, const Vec3& p, const Vec3& v, const Vec3& w) {
+    BodyDef b = box(name, p, 1, Vec3(0.2, 0.2, 0.2));
+    b.linear_velocity = v;
+    b.angular_velocity = w;
+    return b;
+  };
+  const auto six = [](const std::string& name, int body, const Vec3& anchor) {
+    JointDef j;
+    j.name = name;
+    j.type = JointType::SixDof;
+    j.body_a = BodyId{body};
+    j.body_b = kWorldBody;
+    j.anchor = anchor;
+    j.axis = Vec3::UnitX();
+    j.axis2 = Vec3::UnitY();
+    for (DofDef& d : j.dofs) d.mode = DofMode::Locked;
+    return j;
+  };
+  {
+    SceneDesc scene = emptyScene(Vec3::Zero());
+    scene.bodies = {cube("driven", Vec3::Zero(), Vec3::Zero(), Vec3::Zero())};
+    JointDef j = six("motors", 0, Vec3::Zero());
+    j.dofs[0] = DofDef{DofMode::Free, {}, {}, MotorDef{true, 0.5, 100, {}, {}}};
+    j.dofs[3] = DofDef{DofMode::Free, {}, {}, MotorDef{true, 1, 100, {}, {}}};
+    scene.joints = {j};
+    BulletOracle oracle(scene);
+    for (int n = 0; n < 30; ++n) oracle.step();
+    EXPECT_LT((oracle.state(0).linear_velocity - Vec3(0.5, 0, 0)).norm(), 1e-6);
+    EXPECT_LT((oracle.state(0).angular_velocity - Vec3(1, 0, 0)).norm(), 1e-6);
+  }
+  for (const Real dir : {1.0, -1.0}) {
+    SCOPED_TRACE(dir);
+    SceneDesc scene = emptyScene(Vec3::Zero());
+    scene.bodies = {cube("slid", Vec3::Zero(), Vec3(0, dir, 0), Vec3::Zero()),
+                    cube("turned", Vec3(3, 0, 0), Vec3::Zero(), Vec3(0, 0, dir))};
+    JointDef slid = six("slid", 0, Vec3::Zero());
+    slid.dofs[1].mode = DofMode::Limited;
+    slid.dofs[1].limit = LimitDef{true, -0.25, 0.15, 0, {}};
+    JointDef turned = six("turned", 1, Vec3(3, 0, 0));
+    turned.dofs[5].mode = DofMode::Limited;
+    turned.dofs[5].limit = LimitDef{true, -0.2, 0.3, 0, {}};
+    scene.joints = {slid, turned};
+    BulletOracle oracle(scene);
+    for (int n = 0; n < 60; ++n) oracle.step();
+    EXPECT_NEAR(oracle.state(0).position.y(), dir > 0 ? 0.15 : -0.25, 0.02);
+    EXPECT_NEAR(angleAbout(oracle.state(1).orientation, Vec3::UnitZ()), dir > 0 ? 0.3 : -0.2, 0.02);
+  }
+  {
+    SceneDesc scene = emptyScene();
+    scene.bodies = {cube("hung", Vec3::Zero(), Vec3::Zero(), Vec3::Zero()),
+                    cube("wound", Vec3(3, 0, 0), Vec3::Zero(), Vec3::Zero())};
+    const Real k = 100;
+    JointDef hung = six("hung", 0, Vec3::Zero());
+    hung.dofs[1].mode = DofMode::Free;
+    hung.dofs[1].spring = DofSpringDef{true, 0.1, {}};
+    hung.dofs[1].spring.softness.stiffness = k;
+    hung.dofs[1].spring.softness.damping = 10;
+    JointDef wound = six("wound", 1, Vec3(3, 0, 0));
+    wound.dofs[5].mode = DofMode::Free;
+    wound.dofs[5].spring = DofSpringDef{true, 0.3, {}};
+    wound.dofs[5].spring.softness.stiffness = 2;
+    wound.dofs[5].spring.softness.damping = 0.2;
+    scene.joints = {hung, wound};
+    BulletOracle oracle(scene);
+    for (int n = 0; n < 180; ++n) oracle.step();
+    EXPECT_NEAR(oracle.state(0).position.y(), 0.1 - kG / k, 1e-3);
+    EXPECT_NEAR(angleAbout(oracle.state(1).orientation, Vec3::UnitZ()), 0.3, 1e-3);
   }
 }
 

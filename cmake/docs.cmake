@@ -8,6 +8,7 @@ if(DOXYGEN_FOUND)
   configure_file(${PROJECT_SOURCE_DIR}/docs/Doxyfile.in ${CAIRN_DOXYFILE} @ONLY)
   file(GLOB CAIRN_PUBLIC_HEADERS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/include/cairn/*.hpp)
   add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/docs/api/html/index.html
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/docs/api
     COMMAND ${DOXYGEN_EXECUTABLE} ${CAIRN_DOXYFILE}
     DEPENDS ${CAIRN_PUBLIC_HEADERS} ${PROJECT_SOURCE_DIR}/docs/Doxyfile.in
     COMMENT "API reference from include/cairn (Doxygen)"

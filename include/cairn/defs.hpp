@@ -1,6 +1,7 @@
-// Definitions: plain structs a user fills and hands to World::create*, as in
-// Box2D's b2BodyDef. Every field has a usable default. The World validates a
-// definition completely before it changes anything.
+/// @file
+/// Definitions: plain structs a user fills and hands to World::create*, as in
+/// Box2D's b2BodyDef. Every field has a usable default. The World validates a
+/// definition completely before it changes anything.
 #pragma once
 
 #include "cairn/handles.hpp"
@@ -20,50 +21,50 @@ const char* bodyTypeName(BodyType t);
 struct BodyDef {
   std::string name;
   BodyType type = BodyType::Dynamic;
-  // Exactly one of mass and density for a dynamic body with shapes; a
-  // dynamic body without volume (no shapes) needs mass and inertia.
+  /// Exactly one of mass and density for a dynamic body with shapes; a
+  /// dynamic body without volume (no shapes) needs mass and inertia.
   std::optional<Real> mass;
   std::optional<Real> density;
-  std::optional<Mat3> inertia;  // body frame, about the center of mass
-  Vec3 position = Vec3::Zero();  // of the body frame origin (shapes are offset from it)
+  std::optional<Mat3> inertia;  ///< body frame, about the center of mass
+  Vec3 position = Vec3::Zero();  ///< of the body frame origin (shapes are offset from it)
   Quat orientation = Quat::Identity();
   Vec3 linear_velocity = Vec3::Zero();
-  Vec3 angular_velocity = Vec3::Zero();  // world frame, rad/s
+  Vec3 angular_velocity = Vec3::Zero();  ///< world frame, rad/s
   std::vector<ShapeDesc> shapes;
   Real friction = Real(0.5);
   Real restitution = 0;
-  Real rolling_friction = 0;    // m
-  Real torsional_friction = 0;  // m
+  Real rolling_friction = 0;    ///< m
+  Real torsional_friction = 0;  ///< m
   Real linear_damping = 0;
   Real angular_damping = 0;
   bool ccd = false;
-  // Collision filtering: two shapes collide when
-  // (a.group & b.mask) != 0 and (b.group & a.mask) != 0.
+  /// Collision filtering: two shapes collide when
+  /// (a.group & b.mask) != 0 and (b.group & a.mask) != 0.
   std::uint32_t collision_group = 1;
   std::uint32_t collision_mask = 0xffffffffu;
-  bool sleeping_allowed = true;  // false: the body's island never sleeps
+  bool sleeping_allowed = true;  ///< false: the body's island never sleeps
 
-  // External loads (world frame), for scripted pushes in scene files:
-  // a force and a torque applied at the center of mass in every step, and
-  // impulses applied once each, at the start of the first step that begins
-  // at or after their time.
-  Vec3 force = Vec3::Zero();   // N
-  Vec3 torque = Vec3::Zero();  // N m
+  /// External loads (world frame), for scripted pushes in scene files:
+  /// a force and a torque applied at the center of mass in every step, and
+  /// impulses applied once each, at the start of the first step that begins
+  /// at or after their time.
+  Vec3 force = Vec3::Zero();   ///< N
+  Vec3 torque = Vec3::Zero();  ///< N m
   struct TimedImpulse {
-    Real time = 0;                   // s
-    Vec3 impulse = Vec3::Zero();     // N s
-    std::optional<Vec3> point;       // world point at that time; default: the center of mass
+    Real time = 0;                   ///< s
+    Vec3 impulse = Vec3::Zero();     ///< N s
+    std::optional<Vec3> point;       ///< world point at that time; default: the center of mass
   };
   std::vector<TimedImpulse> impulses;
 
-  // Degrees of freedom locked by the mass matrix (Jolt's AllowedDOFs,
-  // Bullet's linear and angular factors): world axes the body may neither
-  // translate along nor rotate about. The effective inverse mass and
-  // inertia are projected so that no impulse or force moves the body along
-  // them, exactly (no constraint rows that could stretch). Translation
-  // locks take the world axes x, y and z (unit vectors, either sign); a
-  // translation along any other line is a slider joint's job. Rotation
-  // locks take any non-zero world vectors.
+  /// Degrees of freedom locked by the mass matrix (Jolt's AllowedDOFs,
+  /// Bullet's linear and angular factors): world axes the body may neither
+  /// translate along nor rotate about. The effective inverse mass and
+  /// inertia are projected so that no impulse or force moves the body along
+  /// them, exactly (no constraint rows that could stretch). Translation
+  /// locks take the world axes x, y and z (unit vectors, either sign); a
+  /// translation along any other line is a slider joint's job. Rotation
+  /// locks take any non-zero world vectors.
   std::vector<Vec3> lock_translation;
   std::vector<Vec3> lock_rotation;
 };
@@ -71,16 +72,16 @@ struct BodyDef {
 struct SpringDef {
   std::string name;
   BodyId body_a = kWorldBody, body_b = kWorldBody;
-  Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();  // world points at creation
-  std::optional<Real> rest_length;  // default: the anchors' distance at creation
-  Real stiffness = 0;  // N/m
-  Real damping = 0;    // N s/m
+  Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();  ///< world points at creation
+  std::optional<Real> rest_length;  ///< default: the anchors' distance at creation
+  Real stiffness = 0;  ///< N/m
+  Real damping = 0;    ///< N s/m
 };
 
-// Softness of a constraint in one of three spellings (docs/constraints.md):
-// raw ERP/CFM, a spring (stiffness N/m or N m/rad, damping N s/m), or a
-// frequency (Hz) and damping ratio. Unset fields fall back to the solver's
-// global ERP and CFM.
+/// Softness of a constraint in one of three spellings (docs/constraints.md):
+/// raw ERP/CFM, a spring (stiffness N/m or N m/rad, damping N s/m), or a
+/// frequency (Hz) and damping ratio. Unset fields fall back to the solver's
+/// global ERP and CFM.
 struct Softness {
   std::optional<Real> erp, cfm;
   std::optional<Real> stiffness, damping;
@@ -90,15 +91,15 @@ struct Softness {
 
 struct LimitDef {
   bool enabled = false;
-  Real lower = 0, upper = 0;  // rad for angular limits, m for linear ones
+  Real lower = 0, upper = 0;  ///< rad for angular limits, m for linear ones
   Real restitution = 0;
   Softness softness;
 };
 
 struct MotorDef {
   bool enabled = false;
-  Real target_velocity = 0;  // rad/s or m/s
-  Real max_force = 0;        // N or N m; the row's bounds are +- max_force h
+  Real target_velocity = 0;  ///< rad/s or m/s
+  Real max_force = 0;        ///< N or N m; the row's bounds are +- max_force h
 };
 
 enum class JointType { Ball, Hinge, Slider, Fixed, Universal, ConeTwist, Distance, AngularMotor };
@@ -109,23 +110,23 @@ struct JointDef {
   std::string name;
   JointType type = JointType::Ball;
   BodyId body_a = kWorldBody, body_b = kWorldBody;
-  Vec3 anchor = Vec3::Zero();        // world frame at creation
-  Vec3 axis = Vec3::UnitZ();         // hinge/slider axis, cone-twist twist axis, universal axis on a
-  Vec3 axis2 = Vec3::UnitX();        // universal: axis on b
-  Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();  // distance joint
-  std::optional<Real> length;        // distance joint, default: the anchors' distance
-  LimitDef limit;                    // hinge angle, slider distance, cone-twist twist
-  Real swing_span1 = kPi, swing_span2 = kPi;  // cone-twist cone half-angles (rad)
-  MotorDef motor;                    // hinge, slider
-  // Angular motor: target angular velocity of b relative to a on up to three
-  // world axes, each with its own maximum torque.
+  Vec3 anchor = Vec3::Zero();        ///< world frame at creation
+  Vec3 axis = Vec3::UnitZ();         ///< hinge/slider axis, cone-twist twist axis, universal axis on a
+  Vec3 axis2 = Vec3::UnitX();        ///< universal: axis on b
+  Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();  ///< distance joint
+  std::optional<Real> length;        ///< distance joint, default: the anchors' distance
+  LimitDef limit;                    ///< hinge angle, slider distance, cone-twist twist
+  Real swing_span1 = kPi, swing_span2 = kPi;  ///< cone-twist cone half-angles (rad)
+  MotorDef motor;                    ///< hinge, slider
+  /// Angular motor: target angular velocity of b relative to a on up to three
+  /// world axes, each with its own maximum torque.
   std::vector<Vec3> motor_axes;
   std::vector<Real> motor_targets;
   std::vector<Real> motor_max_torques;
   Softness softness;
-  Real break_force = kInf;  // N; the joint is removed when its force exceeds this
+  Real break_force = kInf;  ///< N; the joint is removed when its force exceeds this
   Real break_torque = kInf;
   bool collide_connected = false;
 };
 
-}  // namespace cairn
+}  ///< namespace cairn

@@ -1,6 +1,7 @@
-// The one exception type for bad input. It names the object ("body 'crate'",
-// "joint 'hinge1'", "solver") and the field ("mass", "shapes[1].radius"), so
-// the command line can print one line that says exactly what to fix.
+/// @file
+/// The one exception type for bad input. It names the object ("body 'crate'",
+/// "joint 'hinge1'", "solver") and the field ("mass", "shapes[1].radius"), so
+/// the command line can print one line that says exactly what to fix.
 #pragma once
 
 #include <stdexcept>
@@ -33,17 +34,17 @@ class InputError : public std::runtime_error {
   std::string object_, field_, message_;
 };
 
-// A handle that names nothing in this world: its object was destroyed (a
-// stale handle: the slot's generation moved on) or it never existed here.
+/// A handle that names nothing in this world: its object was destroyed (a
+/// stale handle: the slot's generation moved on) or it never existed here.
 class HandleError : public InputError {
  public:
   HandleError(std::string object, const std::string& message) : InputError(std::move(object), "", message) {}
 };
 
-// A step that produced a non-finite state: names the body and the stage.
+/// A step that produced a non-finite state: names the body and the stage.
 class NumericalError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
-}  // namespace cairn
+}  ///< namespace cairn

@@ -1,8 +1,9 @@
-// Handles: small integers into the World's arrays, never pointers (Box2D's
-// b2BodyId, Jolt's BodyID). Each carries the generation of its slot: when
-// an object is destroyed its slot's generation advances, so a handle kept
-// past the destruction is recognised as stale and refused with a
-// HandleError instead of reaching whatever reuses the slot.
+/// @file
+/// Handles: small integers into the World's arrays, never pointers (Box2D's
+/// b2BodyId, Jolt's BodyID). Each carries the generation of its slot: when
+/// an object is destroyed its slot's generation advances, so a handle kept
+/// past the destruction is recognised as stale and refused with a
+/// HandleError instead of reaching whatever reuses the slot.
 #pragma once
 
 #include <cstdint>
@@ -10,7 +11,7 @@
 namespace cairn {
 
 struct BodyId {
-  std::int32_t index = -1;  // -1: the world (the static frame every joint may attach to)
+  std::int32_t index = -1;  ///< -1: the world (the static frame every joint may attach to)
   std::uint32_t generation = 0;
   bool isWorld() const { return index < 0; }
   friend bool operator==(BodyId a, BodyId b) { return a.index == b.index && a.generation == b.generation; }
@@ -18,7 +19,7 @@ struct BodyId {
 inline constexpr BodyId kWorldBody{};
 
 struct JointId {
-  std::int32_t index = -1;  // -1: no joint
+  std::int32_t index = -1;  ///< -1: no joint
   std::uint32_t generation = 0;
   bool isValid() const { return index >= 0; }
   friend bool operator==(JointId a, JointId b) { return a.index == b.index && a.generation == b.generation; }
@@ -31,7 +32,7 @@ struct SpringId {
   friend bool operator==(SpringId a, SpringId b) { return a.index == b.index && a.generation == b.generation; }
 };
 
-// A shape of a body: the world's shape slot.
+/// A shape of a body: the world's shape slot.
 struct ShapeId {
   std::int32_t index = -1;
   std::uint32_t generation = 0;
@@ -39,4 +40,4 @@ struct ShapeId {
   friend bool operator==(ShapeId a, ShapeId b) { return a.index == b.index && a.generation == b.generation; }
 };
 
-}  // namespace cairn
+}  ///< namespace cairn

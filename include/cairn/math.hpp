@@ -1,8 +1,9 @@
-// Scalar and vector aliases used everywhere in cairn, and the few rotation
-// helpers the integrators and constraint parts share.
-//
-// cairn computes in double precision (Real = double) so that it can be
-// compared with Bullet's float64 build without a precision gap.
+/// @file
+/// Scalar and vector aliases used everywhere in cairn, and the few rotation
+/// helpers the integrators and constraint parts share.
+///
+/// cairn computes in double precision (Real = double) so that it can be
+/// compared with Bullet's float64 build without a precision gap.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,16 +23,16 @@ using Quat = Eigen::Quaternion<Real>;
 inline constexpr Real kInf = std::numeric_limits<Real>::infinity();
 inline constexpr Real kPi = 3.14159265358979323846;
 
-// Cross-product matrix: skew(a) * b == a.cross(b).
+/// Cross-product matrix: skew(a) * b == a.cross(b).
 inline Mat3 skew(const Vec3& a) {
   Mat3 m;
   m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
   return m;
 }
 
-// Exponential map (section 12.6.4): the unit quaternion of a rotation by
-// |theta| radians about theta / |theta|. Below 1e-8 rad the Taylor series of
-// sin(x/2)/x keeps the result exact to round-off instead of dividing by ~0.
+/// Exponential map (section 12.6.4): the unit quaternion of a rotation by
+/// |theta| radians about theta / |theta|. Below 1e-8 rad the Taylor series of
+/// sin(x/2)/x keeps the result exact to round-off instead of dividing by ~0.
 inline Quat quatFromRotationVector(const Vec3& theta) {
   const Real angle = theta.norm();
   const Real half = Real(0.5) * angle;
@@ -40,14 +41,14 @@ inline Quat quatFromRotationVector(const Vec3& theta) {
   return Quat(std::cos(half), s * theta.x(), s * theta.y(), s * theta.z());
 }
 
-// Inverse of quatFromRotationVector for a unit quaternion: the rotation
-// vector of the shortest rotation (angle in [0, pi]).
+/// Inverse of quatFromRotationVector for a unit quaternion: the rotation
+/// vector of the shortest rotation (angle in [0, pi]).
 inline Vec3 rotationVectorFromQuat(const Quat& q_in) {
   Quat q = q_in;
   if (q.w() < 0) q.coeffs() = -q.coeffs();
   const Vec3 v = q.vec();
   const Real s = v.norm();
-  if (s < Real(1e-12)) return Real(2) * v;  // small-angle limit
+  if (s < Real(1e-12)) return Real(2) * v;  ///< small-angle limit
   const Real angle = Real(2) * std::atan2(s, q.w());
   return v * (angle / s);
 }
@@ -56,14 +57,14 @@ inline bool allFinite(const Vec3& v) { return v.allFinite(); }
 inline bool allFinite(const Quat& q) { return q.coeffs().allFinite(); }
 inline bool allFinite(const Mat3& m) { return m.allFinite(); }
 
-// Any unit vector perpendicular to n (n need not be unit). Used for
-// friction tangents and joint reference axes.
+/// Any unit vector perpendicular to n (n need not be unit). Used for
+/// friction tangents and joint reference axes.
 inline Vec3 anyPerpendicular(const Vec3& n) {
   const Vec3 a = std::abs(n.x()) < Real(0.57735) ? Vec3::UnitX() : Vec3::UnitY();
   return n.cross(a).normalized();
 }
 
-// A rigid transform: world point = p + R * local.
+/// A rigid transform: world point = p + R * local.
 struct Transform {
   Vec3 p = Vec3::Zero();
   Quat q = Quat::Identity();
@@ -75,4 +76,4 @@ struct Transform {
   }
 };
 
-}  // namespace cairn
+}  ///< namespace cairn

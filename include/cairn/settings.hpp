@@ -1,6 +1,6 @@
 /// @file
 /// Everything a user tunes about a step, with Bullet-like defaults where a
-/// default matters when comparing (../shared/SCENARIOS.md). Scene files set
+/// default matters when comparing (docs/scenarios.md). Scene files set
 /// these under "solver" (docs/scene-format.md).
 #pragma once
 
@@ -78,7 +78,7 @@ struct SolverSettings {
   /// docs/constraints.md measures all three.
   Correction position_correction = Correction::VelocityBias;
 
-  /// Contacts (issue: collision).
+  /// Contacts.
   Real contact_erp = Real(0.2);
   Real slop = Real(0.005);               ///< allowed penetration, m
   Real restitution_threshold = Real(0.2); ///< m/s: slower approach does not bounce

@@ -17,7 +17,7 @@ namespace cairn {
 enum class BodyType { Static, Kinematic, Dynamic };
 
 const char* bodyTypeName(BodyType t);
-
+/// A rigid body to create (World::createBody).
 struct BodyDef {
   std::string name;
   BodyType type = BodyType::Dynamic;
@@ -68,7 +68,7 @@ struct BodyDef {
   std::vector<Vec3> lock_translation;
   std::vector<Vec3> lock_rotation;
 };
-
+/// A linear spring-damper between two anchors (World::createSpring).
 struct SpringDef {
   std::string name;
   BodyId body_a = kWorldBody, body_b = kWorldBody;
@@ -88,14 +88,14 @@ struct Softness {
   std::optional<Real> frequency, damping_ratio;
   bool isSet() const { return erp || cfm || stiffness || damping || frequency || damping_ratio; }
 };
-
+/// A joint's limit on its angle or distance.
 struct LimitDef {
   bool enabled = false;
   Real lower = 0, upper = 0;  ///< rad for angular limits, m for linear ones
   Real restitution = 0;
   Softness softness;
 };
-
+/// A hinge's or slider's velocity motor.
 struct MotorDef {
   bool enabled = false;
   Real target_velocity = 0;  ///< rad/s or m/s
@@ -105,7 +105,7 @@ struct MotorDef {
 enum class JointType { Ball, Hinge, Slider, Fixed, Universal, ConeTwist, Distance, AngularMotor };
 
 const char* jointTypeName(JointType t);
-
+/// A joint to create (World::createJoint); which fields count depends on its type.
 struct JointDef {
   std::string name;
   JointType type = JointType::Ball;

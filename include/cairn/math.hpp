@@ -14,14 +14,14 @@
 
 namespace cairn {
 
-using Real = double;
-using Vec3 = Eigen::Matrix<Real, 3, 1>;
-using Vec4 = Eigen::Matrix<Real, 4, 1>;
-using Mat3 = Eigen::Matrix<Real, 3, 3>;
-using Quat = Eigen::Quaternion<Real>;
+using Real = double;  ///< every scalar: double precision
+using Vec3 = Eigen::Matrix<Real, 3, 1>;  ///< 3-vector (m, m/s, N, ...)
+using Vec4 = Eigen::Matrix<Real, 4, 1>;  ///< 4-vector
+using Mat3 = Eigen::Matrix<Real, 3, 3>;  ///< 3x3 matrix (rotations, inertia tensors)
+using Quat = Eigen::Quaternion<Real>;  ///< unit quaternion: Quat(w, x, y, z), rotates v as q * v
 
-inline constexpr Real kInf = std::numeric_limits<Real>::infinity();
-inline constexpr Real kPi = 3.14159265358979323846;
+inline constexpr Real kInf = std::numeric_limits<Real>::infinity();  ///< infinity: no limit
+inline constexpr Real kPi = 3.14159265358979323846;  ///< pi
 
 /// Cross-product matrix: skew(a) * b == a.cross(b).
 inline Mat3 skew(const Vec3& a) {
@@ -53,9 +53,9 @@ inline Vec3 rotationVectorFromQuat(const Quat& q_in) {
   return v * (angle / s);
 }
 
-inline bool allFinite(const Vec3& v) { return v.allFinite(); }
-inline bool allFinite(const Quat& q) { return q.coeffs().allFinite(); }
-inline bool allFinite(const Mat3& m) { return m.allFinite(); }
+inline bool allFinite(const Vec3& v) { return v.allFinite(); }  ///< no NaN or infinity
+inline bool allFinite(const Quat& q) { return q.coeffs().allFinite(); }  ///< no NaN or infinity
+inline bool allFinite(const Mat3& m) { return m.allFinite(); }  ///< no NaN or infinity
 
 /// Any unit vector perpendicular to n (n need not be unit). Used for
 /// friction tangents and joint reference axes.
@@ -66,12 +66,12 @@ inline Vec3 anyPerpendicular(const Vec3& n) {
 
 /// A rigid transform: world point = p + R * local.
 struct Transform {
-  Vec3 p = Vec3::Zero();
-  Quat q = Quat::Identity();
+  Vec3 p = Vec3::Zero();  ///< translation (m)
+  Quat q = Quat::Identity();  ///< rotation
 
-  Vec3 apply(const Vec3& local) const { return p + q * local; }
-  Vec3 applyInverse(const Vec3& world) const { return q.conjugate() * (world - p); }
-  Transform operator*(const Transform& child) const {
+  Vec3 apply(const Vec3& local) const { return p + q * local; }  ///< local point to world
+  Vec3 applyInverse(const Vec3& world) const { return q.conjugate() * (world - p); }  ///< world point to local
+  Transform operator*(const Transform& child) const {  ///< this after child: child frame to world
     return Transform{apply(child.p), (q * child.q).normalized()};
   }
 };

@@ -17,7 +17,7 @@
 #include <optional>
 
 namespace cairn {
-
+/// A ray cast hit (World::castRay).
 struct RayHit {
   BodyId body;
   ShapeId shape;
@@ -26,7 +26,7 @@ struct RayHit {
   Vec3 normal = Vec3::Zero();  ///< world, unit, out of the shape hit
   std::int32_t triangle = -1;  ///< triangle meshes: the triangle hit
 };
-
+/// A shape cast hit (World::castShape).
 struct ShapeCastHit {
   BodyId body;
   ShapeId shape;

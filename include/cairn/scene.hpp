@@ -13,7 +13,7 @@
 namespace cairn {
 
 class World;
-
+/// A whole scene: gravity, step, solver settings, bodies, springs, joints.
 struct SceneDesc {
   std::string path;  ///< where it was read from, for messages ("" if built in code)
   Vec3 gravity = Vec3(0, Real(-9.81), 0);

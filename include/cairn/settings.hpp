@@ -48,7 +48,7 @@ const char* simdName(Simd s);
 enum class SolverMethod { PGS, Direct, LCP };
 
 const char* solverMethodName(SolverMethod m);
-
+/// The solver settings of a World (World::setSettings).
 struct SolverSettings {
   SolverMethod method = SolverMethod::PGS;
   int iterations = 10;          ///< PGS sweeps per step (Bullet: 10)

@@ -55,7 +55,7 @@ struct TriangleMeshData {
   std::vector<BvhNode> bvh;
   std::vector<int> bvh_order;  ///< triangle indices, grouped by leaf
 };
-
+/// A collision shape: its type, its sizes, its pose in the body frame.
 struct ShapeDesc {
   ShapeType type = ShapeType::Sphere;
   Real radius = 0;

@@ -39,7 +39,7 @@ enum class Stage : std::uint8_t {
 };
 inline constexpr int kStageCount = static_cast<int>(Stage::Count);
 const char* stageName(Stage s);
-
+/// What the last step reports (World::lastStepStats).
 struct StepStats {
   int iterations = 0;        ///< PGS sweeps done (summed over substeps)
   double residual = 0;       ///< natural-map LCP residual after the solve (max norm, last substep)

@@ -64,7 +64,7 @@ struct ContactData {
   Vec3 friction_impulses[4];     ///< N s over the last step, world vectors
   bool touching = false;
 };
-
+/// The simulation: bodies, shapes, joints, springs, and the step.
 class World {
  public:
   explicit World(const WorldDef& def = {});

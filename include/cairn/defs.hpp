@@ -14,9 +14,9 @@
 
 namespace cairn {
 
-enum class BodyType { Static, Kinematic, Dynamic };
+enum class BodyType { Static, Kinematic, Dynamic };  ///< how a body moves: not at all, as scripted, or by forces
 
-const char* bodyTypeName(BodyType t);
+const char* bodyTypeName(BodyType t);  ///< lower-case name, as in scene files
 /// A rigid body to create (World::createBody).
 struct BodyDef {
   std::string name;
@@ -102,9 +102,9 @@ struct MotorDef {
   Real max_force = 0;        ///< N or N m; the row's bounds are +- max_force h
 };
 
-enum class JointType { Ball, Hinge, Slider, Fixed, Universal, ConeTwist, Distance, AngularMotor };
+enum class JointType { Ball, Hinge, Slider, Fixed, Universal, ConeTwist, Distance, AngularMotor };  ///< the joints cairn has (docs/constraints.md)
 
-const char* jointTypeName(JointType t);
+const char* jointTypeName(JointType t);  ///< lower-case name, as in scene files
 /// A joint to create (World::createJoint); which fields count depends on its type.
 struct JointDef {
   std::string name;

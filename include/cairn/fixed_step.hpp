@@ -76,8 +76,8 @@ class FixedStepDriver {
 
   /// Steps run by this driver, and time dropped by the cap (s).
   std::int64_t steps() const { return steps_; }
-  Real droppedTime() const { return dropped_; }
-  const FixedStepSettings& settings() const { return settings_; }
+  Real droppedTime() const { return dropped_; }  ///< time dropped by the cap (s)
+  const FixedStepSettings& settings() const { return settings_; }  ///< the settings given
 
  private:
   struct Saved {

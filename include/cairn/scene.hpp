@@ -25,7 +25,7 @@ struct SceneDesc {
   std::vector<JointDef> joints;
   std::string validation_json;  ///< the raw "validation" block, read by validation/
 
-  int bodyIndex(const std::string& name) const {
+  int bodyIndex(const std::string& name) const {  ///< index in bodies, -1 when none
     for (size_t i = 0; i < bodies.size(); ++i)
       if (bodies[i].name == name) return static_cast<int>(i);
     return -1;

@@ -43,14 +43,14 @@ enum class OrientationIntegrator {
 /// (docs/performance.md); Portable runs on any CPU.
 enum class Simd { Auto, Portable, Avx2, Avx512 };
 
-const char* simdName(Simd s);
+const char* simdName(Simd s);  ///< lower-case name, as in scene files
 
-enum class SolverMethod { PGS, Direct, LCP };
+enum class SolverMethod { PGS, Direct, LCP };  ///< PGS, the CHOLMOD direct solver or the exact LCP (docs/solvers-exact.md)
 
-const char* solverMethodName(SolverMethod m);
+const char* solverMethodName(SolverMethod m);  ///< lower-case name, as in scene files
 /// The solver settings of a World (World::setSettings).
 struct SolverSettings {
-  SolverMethod method = SolverMethod::PGS;
+  SolverMethod method = SolverMethod::PGS;  ///< the velocity solver
   int iterations = 10;          ///< PGS sweeps per step (Bullet: 10)
   Real tolerance = 0;           ///< early exit when no impulse changed by more than this in a sweep (N s); 0 = never
   Real sor = 1;                 ///< successive over-relaxation factor, (0, 2)

@@ -23,9 +23,9 @@
 
 namespace cairn {
 
-enum class ShapeType { Sphere, Box, Capsule, Cylinder, Plane, ConvexHull, Mesh };
+enum class ShapeType { Sphere, Box, Capsule, Cylinder, Plane, ConvexHull, Mesh };  ///< the kinds of shape
 
-const char* shapeTypeName(ShapeType t);
+const char* shapeTypeName(ShapeType t);  ///< lower-case name, as in scene files
 
 /// A convex polyhedron: vertices, faces as vertex loops (counter-clockwise
 /// seen from outside) and one outward unit plane per face (n, d: n.x = d).
@@ -57,22 +57,22 @@ struct TriangleMeshData {
 };
 /// A collision shape: its type, its sizes, its pose in the body frame.
 struct ShapeDesc {
-  ShapeType type = ShapeType::Sphere;
-  Real radius = 0;
-  Real half_height = 0;
-  Vec3 half_extents = Vec3::Zero();
+  ShapeType type = ShapeType::Sphere;  ///< which shape; the fields below it uses
+  Real radius = 0;  ///< sphere, capsule, cylinder (m)
+  Real half_height = 0;  ///< capsule segment, cylinder (m)
+  Vec3 half_extents = Vec3::Zero();  ///< box (m)
   Vec3 normal = Vec3::UnitY();  ///< plane
   Real offset = 0;              ///< plane
-  std::shared_ptr<const ConvexHullData> hull;
-  std::shared_ptr<const TriangleMeshData> mesh;
+  std::shared_ptr<const ConvexHullData> hull;  ///< convex hull
+  std::shared_ptr<const TriangleMeshData> mesh;  ///< triangle mesh
   std::string source;  ///< e.g. the OBJ path a mesh came from (for messages)
   Transform local;     ///< pose in the body frame (relative to the body origin)
 
-  static ShapeDesc sphere(Real r) { ShapeDesc s; s.type = ShapeType::Sphere; s.radius = r; return s; }
-  static ShapeDesc box(const Vec3& he) { ShapeDesc s; s.type = ShapeType::Box; s.half_extents = he; return s; }
-  static ShapeDesc capsule(Real r, Real hh) { ShapeDesc s; s.type = ShapeType::Capsule; s.radius = r; s.half_height = hh; return s; }
-  static ShapeDesc cylinder(Real r, Real hh) { ShapeDesc s; s.type = ShapeType::Cylinder; s.radius = r; s.half_height = hh; return s; }
-  static ShapeDesc plane(const Vec3& n, Real d) { ShapeDesc s; s.type = ShapeType::Plane; s.normal = n; s.offset = d; return s; }
+  static ShapeDesc sphere(Real r) { ShapeDesc s; s.type = ShapeType::Sphere; s.radius = r; return s; }  ///< a sphere of radius r
+  static ShapeDesc box(const Vec3& he) { ShapeDesc s; s.type = ShapeType::Box; s.half_extents = he; return s; }  ///< a box of half extents he
+  static ShapeDesc capsule(Real r, Real hh) { ShapeDesc s; s.type = ShapeType::Capsule; s.radius = r; s.half_height = hh; return s; }  ///< a capsule along local y: radius, segment half height
+  static ShapeDesc cylinder(Real r, Real hh) { ShapeDesc s; s.type = ShapeType::Cylinder; s.radius = r; s.half_height = hh; return s; }  ///< a cylinder along local y: radius, half height
+  static ShapeDesc plane(const Vec3& n, Real d) { ShapeDesc s; s.type = ShapeType::Plane; s.normal = n; s.offset = d; return s; }  ///< the half-space n.x <= d (static bodies)
 };
 
 }  ///< namespace cairn

@@ -19,8 +19,8 @@ enum class RowKind : std::uint8_t {
   ContactRolling,
   Count
 };
-inline constexpr int kRowKindCount = static_cast<int>(RowKind::Count);
-const char* rowKindName(RowKind k);
+inline constexpr int kRowKindCount = static_cast<int>(RowKind::Count);  ///< number of row kinds
+const char* rowKindName(RowKind k);  ///< lower-case name
 
 /// The stages of a step, in the order they run (docs/architecture.md walks
 /// through them). Their wall times are kept in StepStats::stage_seconds.
@@ -37,8 +37,8 @@ enum class Stage : std::uint8_t {
   Guards,     ///< the non-finite guard and the step's diagnostics
   Count
 };
-inline constexpr int kStageCount = static_cast<int>(Stage::Count);
-const char* stageName(Stage s);
+inline constexpr int kStageCount = static_cast<int>(Stage::Count);  ///< number of stages
+const char* stageName(Stage s);  ///< lower-case name
 /// What the last step reports (World::lastStepStats).
 struct StepStats {
   int iterations = 0;        ///< PGS sweeps done (summed over substeps)

@@ -49,7 +49,7 @@ struct WorldAccess;
 /// How a world starts: gravity and the solver settings.
 struct WorldDef {
   Vec3 gravity = Vec3(0, Real(-9.81), 0);  ///< m/s^2
-  SolverSettings settings;
+  SolverSettings settings;  ///< solver settings (validated by the World)
 };
 
 /// A contact of a body, as World::contacts(BodyId) reports it after a step.
@@ -67,11 +67,11 @@ struct ContactData {
 /// The simulation: bodies, shapes, joints, springs, and the step.
 class World {
  public:
-  explicit World(const WorldDef& def = {});
-  explicit World(const Vec3& gravity) : World(WorldDef{gravity, {}}) {}
+  explicit World(const WorldDef& def = {});  ///< an empty world
+  explicit World(const Vec3& gravity) : World(WorldDef{gravity, {}}) {}  ///< an empty world with default settings
   ~World();
-  World(World&&) noexcept;
-  World& operator=(World&&) noexcept;
+  World(World&&) noexcept;  ///< moves the whole simulation
+  World& operator=(World&&) noexcept;  ///< moves the whole simulation
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
@@ -84,13 +84,13 @@ class World {
   /// it and its contacts (which end: contact End events are reported with
   /// the next step). Its handle, and theirs, become stale.
   void destroyBody(BodyId id);
-  bool isValid(BodyId id) const;
+  bool isValid(BodyId id) const;  ///< false for a destroyed or foreign body
   int bodyCount() const;                        ///< bodies alive
   std::vector<BodyId> bodies() const;           ///< every body alive, in creation slot order
   BodyId findBody(const std::string& name) const;  ///< kWorldBody when none
-  const std::string& name(BodyId id) const;
+  const std::string& name(BodyId id) const;  ///< the body's name from its definition
 
-  BodyType type(BodyId id) const;
+  BodyType type(BodyId id) const;  ///< static, kinematic or dynamic
   /// Static, kinematic or dynamic at any time. A body becoming dynamic takes
   /// its mass from its definition (mass, or density times its shapes'
   /// volume); one becoming static or kinematic loses its contacts' cached
@@ -105,9 +105,9 @@ class World {
   void setTransform(BodyId id, const Vec3& position, const Quat& orientation);
   Vec3 linearVelocity(BodyId id) const;   ///< of the center of mass, world frame, m/s
   Vec3 angularVelocity(BodyId id) const;  ///< world frame, rad/s
-  void setLinearVelocity(BodyId id, const Vec3& v);
-  void setAngularVelocity(BodyId id, const Vec3& w);
-  Vec3 velocityAt(BodyId id, const Vec3& world_point) const;
+  void setLinearVelocity(BodyId id, const Vec3& v);  ///< of the center of mass (m/s); wakes the body
+  void setAngularVelocity(BodyId id, const Vec3& w);  ///< world frame (rad/s); wakes the body
+  Vec3 velocityAt(BodyId id, const Vec3& world_point) const;  ///< v + w x (x - c) at a world point (m/s)
   Real mass(BodyId id) const;        ///< kg; infinite for static and kinematic bodies
   Mat3 inertia(BodyId id) const;     ///< world frame, about the center of mass
 
@@ -116,30 +116,30 @@ class World {
   /// a dynamic body created from density, recomputes its mass properties
   /// (its center of mass moves, its body frame does not).
   ShapeId addShape(BodyId body, const ShapeDesc& shape);
-  void removeShape(ShapeId shape);
-  std::vector<ShapeId> shapes(BodyId body) const;
-  BodyId shapeBody(ShapeId shape) const;
-  const ShapeDesc& shape(ShapeId shape) const;
+  void removeShape(ShapeId shape);  ///< mass properties follow as for addShape
+  std::vector<ShapeId> shapes(BodyId body) const;  ///< the body's shapes
+  BodyId shapeBody(ShapeId shape) const;  ///< the body a shape belongs to
+  const ShapeDesc& shape(ShapeId shape) const;  ///< a shape's description
 
   // --- Forces -----------------------------------------------------------------
   /// Forces and torques act over the next step and are then cleared;
   /// impulses change the velocity at once. All wake the body.
   void applyForce(BodyId id, const Vec3& force, const Vec3& world_point);
-  void applyCentralForce(BodyId id, const Vec3& force);
-  void applyTorque(BodyId id, const Vec3& torque);
-  void applyImpulse(BodyId id, const Vec3& impulse, const Vec3& world_point);
-  void applyAngularImpulse(BodyId id, const Vec3& angular_impulse);
+  void applyCentralForce(BodyId id, const Vec3& force);  ///< at the center of mass (N)
+  void applyTorque(BodyId id, const Vec3& torque);  ///< world frame (N m)
+  void applyImpulse(BodyId id, const Vec3& impulse, const Vec3& world_point);  ///< N s at a world point
+  void applyAngularImpulse(BodyId id, const Vec3& angular_impulse);  ///< N m s, world frame
   /// Scripted motion of a kinematic body (m/s, rad/s).
   void setKinematicVelocity(BodyId id, const Vec3& linear, const Vec3& angular);
 
   // --- Joints and springs ---------------------------------------------------
-  JointId createJoint(const JointDef& def);
+  JointId createJoint(const JointDef& def);  ///< validates, then creates; InputError on bad input
   /// Removes the joint; the bodies it held are woken. Joints may be removed
   /// between any two steps (a wheel coming off a car).
   void destroyJoint(JointId id);
-  bool isValid(JointId id) const;
+  bool isValid(JointId id) const;  ///< false for a destroyed or foreign joint
   JointId findJoint(const std::string& name) const;  ///< invalid (index -1) when none
-  const JointDef& jointDef(JointId id) const;
+  const JointDef& jointDef(JointId id) const;  ///< the definition the joint was made from
   /// Force and torque the joint applied over the last step, on each body.
   JointFeedback jointFeedback(JointId id) const;
   /// The joint's position error now (anchor separation, angle error).
@@ -151,9 +151,9 @@ class World {
   /// Motors: change a hinge's or slider's motor between steps.
   void setMotor(JointId id, const MotorDef& motor);
 
-  SpringId createSpring(const SpringDef& def);
-  void destroySpring(SpringId id);
-  bool isValid(SpringId id) const;
+  SpringId createSpring(const SpringDef& def);  ///< validates, then creates; InputError on bad input
+  void destroySpring(SpringId id);  ///< removes the spring; its handle becomes stale
+  bool isValid(SpringId id) const;  ///< false for a destroyed or foreign spring
 
   // --- Contacts -----------------------------------------------------------------
   /// Every touching contact of a body after the last step.
@@ -177,11 +177,11 @@ class World {
   /// the bodies are not joined by a joint that forbids it, and the custom
   /// filter (if any) agrees.
   void setCollisionFilter(BodyId id, std::uint32_t group, std::uint32_t mask);
-  using CollisionFilter = std::function<bool(BodyId a, BodyId b)>;
-  void setCollisionFilterCallback(CollisionFilter filter);
+  using CollisionFilter = std::function<bool(BodyId a, BodyId b)>;  ///< true: the pair may collide
+  void setCollisionFilterCallback(CollisionFilter filter);  ///< called during the step; must not call the World
 
   // --- Sleeping -------------------------------------------------------------------
-  bool isAsleep(BodyId id) const;
+  bool isAsleep(BodyId id) const;  ///< true while the body's island sleeps
   void wake(BodyId id);            ///< wakes the body's whole island
   void putToSleep(BodyId id);      ///< puts the body's island to sleep now
   void setSleepingAllowed(BodyId id, bool allowed);  ///< false: its island never sleeps
@@ -198,9 +198,9 @@ class World {
   std::vector<ShapeId> overlap(const ShapeDesc& shape, const Transform& pose, const QueryFilter& filter = {}) const;
 
   // --- Settings -------------------------------------------------------------------
-  const Vec3& gravity() const;
-  void setGravity(const Vec3& g);
-  const SolverSettings& settings() const;
+  const Vec3& gravity() const;  ///< m/s^2
+  void setGravity(const Vec3& g);  ///< m/s^2, from the next step
+  const SolverSettings& settings() const;  ///< the settings in force
   /// Validates and sets; throws InputError naming "solver" and the field.
   void setSettings(const SolverSettings& s);
 
@@ -208,9 +208,9 @@ class World {
   /// Advances the world by h seconds (fixed steps work best: see
   /// FixedStepDriver in cairn/fixed_step.hpp).
   void step(Real h);
-  int stepCount() const;
-  Real time() const;
-  const StepStats& lastStepStats() const;
+  int stepCount() const;  ///< steps taken since creation
+  Real time() const;  ///< simulated time (s)
+  const StepStats& lastStepStats() const;  ///< what the last step reported
   /// Joints broken during the last step.
   std::span<const JointBreakEvent> jointBreakEvents() const;
   /// Non-finite states caught and rolled back, since creation (never
@@ -224,17 +224,17 @@ class World {
   /// contact cache and warm-start impulses) in a versioned binary format. A
   /// world restored from it continues bit-identically to the one saved.
   std::vector<std::uint8_t> saveSnapshot() const;
-  void saveSnapshot(const std::string& path) const;
+  void saveSnapshot(const std::string& path) const;  ///< the snapshot written to a file
   /// Replaces this world's state with the snapshot's; throws InputError (a
   /// snapshot of another format version, truncated or corrupted) and then
   /// leaves the world untouched. Callbacks set on this world are kept.
   void restoreSnapshot(std::span<const std::uint8_t> bytes);
-  void restoreSnapshot(const std::string& path);
+  void restoreSnapshot(const std::string& path);  ///< a snapshot read from a file
 
   // --- Energy and momentum (tests, metrics) ----------------------------------------
-  Real kineticEnergy() const;
+  Real kineticEnergy() const;  ///< J, translational and rotational
   Real potentialEnergy() const;  ///< gravity (relative to the origin along -g) and springs
-  Vec3 linearMomentum() const;
+  Vec3 linearMomentum() const;  ///< N s, of every dynamic body
 
  private:
   friend struct detail::WorldAccess;

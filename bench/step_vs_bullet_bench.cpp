@@ -2,7 +2,7 @@
 // with matched settings (validation/bullet_oracle.hpp, match_cairn), in the
 // same process, one after the other: compare the two rows of a scene, not
 // absolute times (docs/benchmarks.md). One benchmark iteration is the
-// scene's whole run (SCENARIOS.md: 600 steps for the stacks and chains), so
+// scene's whole run (docs/scenarios.md: 600 steps for the stacks and chains), so
 // the settling and the resting phase are both in the figure; the counter
 // ms_per_step is the mean over the run.
 //

@@ -179,7 +179,7 @@ SceneDesc byName(const std::string& key) {
 }  // namespace cairn::scenarios
 
 // ------------------------------------------------------------------------
-// Scenarios of issue 5 beyond SCENARIOS.md's table. Each sets the table's
+// Scenarios beyond docs/scenarios.md's table. Each sets the table's
 // common conditions itself, sleeping off included.
 
 namespace cairn::scenarios {

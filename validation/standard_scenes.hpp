@@ -4,7 +4,7 @@
 // traces to plot, closed-form references). `cairn scenes` writes these;
 // `cairn validate KEY` runs them without a file.
 //
-// Every standard scene runs with sleeping off, as ../shared/SCENARIOS.md
+// Every standard scene runs with sleeping off, as docs/scenarios.md
 // asks (cairn's default is on).
 #pragma once
 

@@ -58,7 +58,7 @@ VaryAxis parseVary(const std::string& arg, const SceneDesc& scene) {
     }
     // "a,b,...,z" or "a,b,c,...,z": the progression the values before it
     // start, continued below z, then z. Geometric when three values share
-    // a ratio (the "1,2,4,...,200": 8 to 128, then 200), else
+    // a ratio ("1,2,4,...,200": 8 to 128, then 200), else
     // arithmetic ("1,2,...,10", "0.1,0.2,...,0.6").
     if (axis.values.size() < 2 || t + 2 != texts.size())
       throw InputError("--vary " + axis.key, "",

@@ -1,6 +1,7 @@
-// The one exception type for bad input. It names the object ("body 'crate'",
-// "joint 'hinge1'", "solver") and the field ("mass", "shapes[1].radius"), so
-// the command line can print one line that says exactly what to fix.
+/// @file
+/// The one exception type for bad input. It names the object ("body 'crate'",
+/// "joint 'hinge1'", "solver") and the field ("mass", "shapes[1].radius"), so
+/// the command line can print one line that says exactly what to fix.
 #pragma once
 
 #include <stdexcept>
@@ -8,20 +9,20 @@
 #include <utility>
 
 namespace cairn {
-
+/// Bad input: names the object and the field.
 class InputError : public std::runtime_error {
  public:
-  InputError(std::string object, std::string field, const std::string& message)
+  InputError(std::string object, std::string field, const std::string& message)  ///< object, field and what is wrong with it
       : std::runtime_error(compose(object, field, message)),
         object_(std::move(object)),
         field_(std::move(field)),
         message_(message) {}
 
-  const std::string& object() const { return object_; }
-  const std::string& field() const { return field_; }
-  const std::string& message() const { return message_; }
+  const std::string& object() const { return object_; }  ///< e.g. "body 'crate'"
+  const std::string& field() const { return field_; }  ///< e.g. "shapes[1].radius"; may be empty
+  const std::string& message() const { return message_; }  ///< what is wrong, without object and field
 
-  static std::string compose(const std::string& object, const std::string& field,
+  static std::string compose(const std::string& object, const std::string& field,  ///< the one-line message what() returns
                              const std::string& message) {
     std::string s;
     if (!object.empty()) s += object;
@@ -33,17 +34,17 @@ class InputError : public std::runtime_error {
   std::string object_, field_, message_;
 };
 
-// A handle that names nothing in this world: its object was destroyed (a
-// stale handle: the slot's generation moved on) or it never existed here.
+/// A handle that names nothing in this world: its object was destroyed (a
+/// stale handle: the slot's generation moved on) or it never existed here.
 class HandleError : public InputError {
  public:
-  HandleError(std::string object, const std::string& message) : InputError(std::move(object), "", message) {}
+  HandleError(std::string object, const std::string& message) : InputError(std::move(object), "", message) {}  ///< the object named and why the handle is refused
 };
 
-// A step that produced a non-finite state: names the body and the stage.
+/// A step that produced a non-finite state: names the body and the stage.
 class NumericalError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
-}  // namespace cairn
+}  ///< namespace cairn

@@ -1,8 +1,9 @@
-// Scalar and vector aliases used everywhere in cairn, and the few rotation
-// helpers the integrators and constraint parts share.
-//
-// cairn computes in double precision (Real = double) so that it can be
-// compared with Bullet's float64 build without a precision gap.
+/// @file
+/// Scalar and vector aliases used everywhere in cairn, and the few rotation
+/// helpers the integrators and constraint parts share.
+///
+/// cairn computes in double precision (Real = double) so that it can be
+/// compared with Bullet's float64 build without a precision gap.
 #pragma once
 
 #include <Eigen/Core>
@@ -13,25 +14,25 @@
 
 namespace cairn {
 
-using Real = double;
-using Vec3 = Eigen::Matrix<Real, 3, 1>;
-using Vec4 = Eigen::Matrix<Real, 4, 1>;
-using Mat3 = Eigen::Matrix<Real, 3, 3>;
-using Quat = Eigen::Quaternion<Real>;
+using Real = double;  ///< every scalar: double precision
+using Vec3 = Eigen::Matrix<Real, 3, 1>;  ///< 3-vector (m, m/s, N, ...)
+using Vec4 = Eigen::Matrix<Real, 4, 1>;  ///< 4-vector
+using Mat3 = Eigen::Matrix<Real, 3, 3>;  ///< 3x3 matrix (rotations, inertia tensors)
+using Quat = Eigen::Quaternion<Real>;  ///< unit quaternion: Quat(w, x, y, z), rotates v as q * v
 
-inline constexpr Real kInf = std::numeric_limits<Real>::infinity();
-inline constexpr Real kPi = 3.14159265358979323846;
+inline constexpr Real kInf = std::numeric_limits<Real>::infinity();  ///< infinity: no limit
+inline constexpr Real kPi = 3.14159265358979323846;  ///< pi
 
-// Cross-product matrix: skew(a) * b == a.cross(b).
+/// Cross-product matrix: skew(a) * b == a.cross(b).
 inline Mat3 skew(const Vec3& a) {
   Mat3 m;
   m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
   return m;
 }
 
-// Exponential map (section 12.6.4): the unit quaternion of a rotation by
-// |theta| radians about theta / |theta|. Below 1e-8 rad the Taylor series of
-// sin(x/2)/x keeps the result exact to round-off instead of dividing by ~0.
+/// Exponential map (section 12.6.4): the unit quaternion of a rotation by
+/// |theta| radians about theta / |theta|. Below 1e-8 rad the Taylor series of
+/// sin(x/2)/x keeps the result exact to round-off instead of dividing by ~0.
 inline Quat quatFromRotationVector(const Vec3& theta) {
   const Real angle = theta.norm();
   const Real half = Real(0.5) * angle;
@@ -40,39 +41,39 @@ inline Quat quatFromRotationVector(const Vec3& theta) {
   return Quat(std::cos(half), s * theta.x(), s * theta.y(), s * theta.z());
 }
 
-// Inverse of quatFromRotationVector for a unit quaternion: the rotation
-// vector of the shortest rotation (angle in [0, pi]).
+/// Inverse of quatFromRotationVector for a unit quaternion: the rotation
+/// vector of the shortest rotation (angle in [0, pi]).
 inline Vec3 rotationVectorFromQuat(const Quat& q_in) {
   Quat q = q_in;
   if (q.w() < 0) q.coeffs() = -q.coeffs();
   const Vec3 v = q.vec();
   const Real s = v.norm();
-  if (s < Real(1e-12)) return Real(2) * v;  // small-angle limit
+  if (s < Real(1e-12)) return Real(2) * v;  ///< small-angle limit
   const Real angle = Real(2) * std::atan2(s, q.w());
   return v * (angle / s);
 }
 
-inline bool allFinite(const Vec3& v) { return v.allFinite(); }
-inline bool allFinite(const Quat& q) { return q.coeffs().allFinite(); }
-inline bool allFinite(const Mat3& m) { return m.allFinite(); }
+inline bool allFinite(const Vec3& v) { return v.allFinite(); }  ///< no NaN or infinity
+inline bool allFinite(const Quat& q) { return q.coeffs().allFinite(); }  ///< no NaN or infinity
+inline bool allFinite(const Mat3& m) { return m.allFinite(); }  ///< no NaN or infinity
 
-// Any unit vector perpendicular to n (n need not be unit). Used for
-// friction tangents and joint reference axes.
+/// Any unit vector perpendicular to n (n need not be unit). Used for
+/// friction tangents and joint reference axes.
 inline Vec3 anyPerpendicular(const Vec3& n) {
   const Vec3 a = std::abs(n.x()) < Real(0.57735) ? Vec3::UnitX() : Vec3::UnitY();
   return n.cross(a).normalized();
 }
 
-// A rigid transform: world point = p + R * local.
+/// A rigid transform: world point = p + R * local.
 struct Transform {
-  Vec3 p = Vec3::Zero();
-  Quat q = Quat::Identity();
+  Vec3 p = Vec3::Zero();  ///< translation (m)
+  Quat q = Quat::Identity();  ///< rotation
 
-  Vec3 apply(const Vec3& local) const { return p + q * local; }
-  Vec3 applyInverse(const Vec3& world) const { return q.conjugate() * (world - p); }
-  Transform operator*(const Transform& child) const {
+  Vec3 apply(const Vec3& local) const { return p + q * local; }  ///< local point to world
+  Vec3 applyInverse(const Vec3& world) const { return q.conjugate() * (world - p); }  ///< world point to local
+  Transform operator*(const Transform& child) const {  ///< this after child: child frame to world
     return Transform{apply(child.p), (q * child.q).normalized()};
   }
 };
 
-}  // namespace cairn
+}  ///< namespace cairn

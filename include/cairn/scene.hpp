@@ -1,6 +1,7 @@
-// A scene in memory: what a scene file holds, independent of any engine.
-// The same SceneDesc builds a cairn World (world/world.hpp) or, for
-// validation, a Bullet world (validation/bullet_oracle.hpp).
+/// @file
+/// A scene in memory: what a scene file holds, independent of any engine.
+/// The same SceneDesc builds a cairn World (world/world.hpp) or, for
+/// validation, a Bullet world (validation/bullet_oracle.hpp).
 #pragma once
 
 #include "cairn/defs.hpp"
@@ -12,9 +13,9 @@
 namespace cairn {
 
 class World;
-
+/// A whole scene: gravity, step, solver settings, bodies, springs, joints.
 struct SceneDesc {
-  std::string path;  // where it was read from, for messages ("" if built in code)
+  std::string path;  ///< where it was read from, for messages ("" if built in code)
   Vec3 gravity = Vec3(0, Real(-9.81), 0);
   Real dt = Real(1) / 60;
   int steps = 600;
@@ -22,17 +23,17 @@ struct SceneDesc {
   std::vector<BodyDef> bodies;
   std::vector<SpringDef> springs;
   std::vector<JointDef> joints;
-  std::string validation_json;  // the raw "validation" block, read by validation/
+  std::string validation_json;  ///< the raw "validation" block, read by validation/
 
-  int bodyIndex(const std::string& name) const {
+  int bodyIndex(const std::string& name) const {  ///< index in bodies, -1 when none
     for (size_t i = 0; i < bodies.size(); ++i)
       if (bodies[i].name == name) return static_cast<int>(i);
     return -1;
   }
 };
 
-// Build a World from a scene. Validates everything first: on bad input it
-// throws InputError and builds nothing.
+/// Build a World from a scene. Validates everything first: on bad input it
+/// throws InputError and builds nothing.
 World buildWorld(const SceneDesc& scene);
 
-}  // namespace cairn
+}  ///< namespace cairn

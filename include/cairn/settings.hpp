@@ -1,6 +1,7 @@
-// Everything a user tunes about a step, with Bullet-like defaults where a
-// default matters when comparing (../shared/SCENARIOS.md). Scene files set
-// these under "solver" (docs/scene-format.md).
+/// @file
+/// Everything a user tunes about a step, with Bullet-like defaults where a
+/// default matters when comparing (docs/scenarios.md). Scene files set
+/// these under "solver" (docs/scene-format.md).
 #pragma once
 
 #include "cairn/math.hpp"
@@ -9,96 +10,96 @@
 
 namespace cairn {
 
-// Where a row's position feedback -ERP/h C goes (settings.hpp explains the
-// choice). InRhs is ODE's single pass; the other two solve it in a second
-// pass from zero impulses, so warm starting carries only the impulse that
-// holds the constraint, never last step's correction.
+/// Where a row's position feedback -ERP/h C goes (settings.hpp explains the
+/// choice). InRhs is ODE's single pass; the other two solve it in a second
+/// pass from zero impulses, so warm starting carries only the impulse that
+/// holds the constraint, never last step's correction.
 enum class Correction : std::uint8_t {
-  InRhs,           // in rhs with the velocity target (ODE quickstep)
-  VelocityBias,    // second pass, result added to the velocities (Baumgarte)
-  PseudoVelocity   // second pass, result moves positions only (split impulse)
+  InRhs,           ///< in rhs with the velocity target (ODE quickstep)
+  VelocityBias,    ///< second pass, result added to the velocities (Baumgarte)
+  PseudoVelocity   ///< second pass, result moves positions only (split impulse)
 };
 
-// How the gyroscopic torque -w x (J w) enters the velocity update
-// (docs/dynamics.md compares them on a tumbling box).
+/// How the gyroscopic torque -w x (J w) enters the velocity update
+/// (docs/dynamics.md compares them on a tumbling box).
 enum class Gyroscopic {
-  Off,             // ignored: w' = J^-1 tau only
-  Explicit,        // forward Euler on the world-frame term (gains energy)
-  ImplicitEuler,   // backward Euler in the body frame, one Newton step
-                   // (Bullet's default: stable but dissipative)
-  ImplicitMidpoint // midpoint rule on the body-frame Euler equations with
-                   // the orientation advanced at the midpoint velocity:
-                   // conserves kinetic energy and L of a free body (default)
+  Off,             ///< ignored: w' = J^-1 tau only
+  Explicit,        ///< forward Euler on the world-frame term (gains energy)
+  ImplicitEuler,   ///< backward Euler in the body frame, one Newton step
+                   /// (Bullet's default: stable but dissipative)
+  ImplicitMidpoint ///< midpoint rule on the body-frame Euler equations with
+                   /// the orientation advanced at the midpoint velocity:
+                   /// conserves kinetic energy and L of a free body (default)
 };
 
-// How the orientation quaternion follows the angular velocity.
+/// How the orientation quaternion follows the angular velocity.
 enum class OrientationIntegrator {
-  ExponentialMap,  // q <- exp(h w) q, exact for constant w (default)
-  Derivative       // q <- normalize(q + h/2 w q), section 12.6.4's first method
+  ExponentialMap,  ///< q <- exp(h w) q, exact for constant w (default)
+  Derivative       ///< q <- normalize(q + h/2 w q), section 12.6.4's first method
 };
 
-// Which vector instructions the contact solver uses. Auto: the widest this
-// CPU supports among those built in. All give bit-identical results
-// (docs/performance.md); Portable runs on any CPU.
+/// Which vector instructions the contact solver uses. Auto: the widest this
+/// CPU supports among those built in. All give bit-identical results
+/// (docs/performance.md); Portable runs on any CPU.
 enum class Simd { Auto, Portable, Avx2, Avx512 };
 
-const char* simdName(Simd s);
+const char* simdName(Simd s);  ///< lower-case name, as in scene files
 
-enum class SolverMethod { PGS, Direct, LCP };
+enum class SolverMethod { PGS, Direct, LCP };  ///< PGS, the CHOLMOD direct solver or the exact LCP (docs/solvers-exact.md)
 
-const char* solverMethodName(SolverMethod m);
-
+const char* solverMethodName(SolverMethod m);  ///< lower-case name, as in scene files
+/// The solver settings of a World (World::setSettings).
 struct SolverSettings {
-  SolverMethod method = SolverMethod::PGS;
-  int iterations = 10;          // PGS sweeps per step (Bullet: 10)
-  Real tolerance = 0;           // early exit when no impulse changed by more than this in a sweep (N s); 0 = never
-  Real sor = 1;                 // successive over-relaxation factor, (0, 2)
-  bool warm_start = true;       // start from last step's impulses
-  Real warm_start_factor = 1;   // scale applied to the carried impulses
-  bool randomize_order = false; // shuffle rows each sweep (seeded, reproducible)
-  bool nncg = true;             // PGS with NNCG momentum between sweeps (solver/pgs.cpp); false: plain PGS as Bullet
+  SolverMethod method = SolverMethod::PGS;  ///< the velocity solver
+  int iterations = 10;          ///< PGS sweeps per step (Bullet: 10)
+  Real tolerance = 0;           ///< early exit when no impulse changed by more than this in a sweep (N s); 0 = never
+  Real sor = 1;                 ///< successive over-relaxation factor, (0, 2)
+  bool warm_start = true;       ///< start from last step's impulses
+  Real warm_start_factor = 1;   ///< scale applied to the carried impulses
+  bool randomize_order = false; ///< shuffle rows each sweep (seeded, reproducible)
+  bool nncg = true;             ///< PGS with NNCG momentum between sweeps (solver/pgs.cpp); false: plain PGS as Bullet
   std::uint64_t seed = 1;
-  int substeps = 1;             // sub-steps per step
-  int threads = 1;              // worker threads for the step (results are bit-identical for any count)
-  Simd simd = Simd::Auto;       // contact solver instruction set
-  bool compute_residual = false;  // fill StepStats::residual (one extra pass over the rows)
+  int substeps = 1;             ///< sub-steps per step
+  int threads = 1;              ///< worker threads for the step (results are bit-identical for any count)
+  Simd simd = Simd::Auto;       ///< contact solver instruction set
+  bool compute_residual = false;  ///< fill StepStats::residual (one extra pass over the rows)
 
-  // ODE-style softness: rows drive J v toward -ERP/h C, CFM softens them.
+  /// ODE-style softness: rows drive J v toward -ERP/h C, CFM softens them.
   Real erp = Real(0.2);
   Real cfm = 0;
-  // Position correction of joint rows without a softness of their own:
-  //  VelocityBias   Baumgarte: -ERP/h C joins the velocities, solved in a
-  //                 second pass that is never warm-started (default)
-  //  PseudoVelocity split impulse: the correction moves positions only,
-  //                 adding no energy (but projecting a fast swing loses some)
-  //  InRhs          ODE's single pass: the correction is warm-started with
-  //                 the rest, which re-applies last step's correction and
-  //                 grows unstable on long chains at few iterations
-  // docs/constraints.md measures all three.
+  /// Position correction of joint rows without a softness of their own:
+  ///  VelocityBias   Baumgarte: -ERP/h C joins the velocities, solved in a
+  ///                 second pass that is never warm-started (default)
+  ///  PseudoVelocity split impulse: the correction moves positions only,
+  ///                 adding no energy (but projecting a fast swing loses some)
+  ///  InRhs          ODE's single pass: the correction is warm-started with
+  ///                 the rest, which re-applies last step's correction and
+  ///                 grows unstable on long chains at few iterations
+  /// docs/constraints.md measures all three.
   Correction position_correction = Correction::VelocityBias;
 
-  // Contacts (issue: collision).
+  /// Contacts.
   Real contact_erp = Real(0.2);
-  Real slop = Real(0.005);               // allowed penetration, m
-  Real restitution_threshold = Real(0.2); // m/s: slower approach does not bounce
-  bool split_impulse = true;              // contacts: push out with pseudo-velocities (Bullet's split impulse)
-  Real max_correction_velocity = Real(10);  // m/s, clamp on ERP push-out
+  Real slop = Real(0.005);               ///< allowed penetration, m
+  Real restitution_threshold = Real(0.2); ///< m/s: slower approach does not bounce
+  bool split_impulse = true;              ///< contacts: push out with pseudo-velocities (Bullet's split impulse)
+  Real max_correction_velocity = Real(10);  ///< m/s, clamp on ERP push-out
 
-  Real contact_margin = Real(0.02);  // m: contacts are made this far before touching (speculative)
+  Real contact_margin = Real(0.02);  ///< m: contacts are made this far before touching (speculative)
 
-  // Sleeping: an island whose bodies all stay below both speeds for
-  // sleep_time seconds sleeps and costs nothing until woken.
+  /// Sleeping: an island whose bodies all stay below both speeds for
+  /// sleep_time seconds sleeps and costs nothing until woken.
   bool sleeping = true;
-  Real sleep_linear_velocity = Real(0.05);   // m/s
-  Real sleep_angular_velocity = Real(0.05);  // rad/s
-  Real sleep_time = Real(0.5);               // s
+  Real sleep_linear_velocity = Real(0.05);   ///< m/s
+  Real sleep_angular_velocity = Real(0.05);  ///< rad/s
+  Real sleep_time = Real(0.5);               ///< s
 
-  // Safety nets for the extremes.
-  Real max_angular_velocity = kInf;  // rad/s, per body
+  /// Safety nets for the extremes.
+  Real max_angular_velocity = kInf;  ///< rad/s, per body
 
-  // Integrators (section 12.6.3 and 12.6.4).
+  /// Integrators (section 12.6.3 and 12.6.4).
   Gyroscopic gyroscopic = Gyroscopic::ImplicitMidpoint;
   OrientationIntegrator orientation = OrientationIntegrator::ExponentialMap;
 };
 
-}  // namespace cairn
+}  ///< namespace cairn

@@ -1,56 +1,57 @@
-// What a step reports about itself: the solver's quality (MuJoCo-style
-// solver statistics) and where the time went, stage by stage. Read it after
-// World::step through World::lastStepStats().
+/// @file
+/// What a step reports about itself: the solver's quality (MuJoCo-style
+/// solver statistics) and where the time went, stage by stage. Read it after
+/// World::step through World::lastStepStats().
 #pragma once
 
 #include <cstdint>
 
 namespace cairn {
 
-// The kinds of constraint rows, for counting.
+/// The kinds of constraint rows, for counting.
 enum class RowKind : std::uint8_t {
-  JointLinear,   // positional rows of joints (anchors coincide, slider axes)
-  JointAngular,  // angular rows of joints (hinge axes, fixed orientation)
-  Limit,         // joint limits (unilateral)
-  Motor,         // velocity motors (bounded by max force)
+  JointLinear,   ///< positional rows of joints (anchors coincide, slider axes)
+  JointAngular,  ///< angular rows of joints (hinge axes, fixed orientation)
+  Limit,         ///< joint limits (unilateral)
+  Motor,         ///< velocity motors (bounded by max force)
   ContactNormal,
   ContactFriction,
   ContactRolling,
   Count
 };
-inline constexpr int kRowKindCount = static_cast<int>(RowKind::Count);
-const char* rowKindName(RowKind k);
+inline constexpr int kRowKindCount = static_cast<int>(RowKind::Count);  ///< number of row kinds
+const char* rowKindName(RowKind k);  ///< lower-case name
 
-// The stages of a step, in the order they run (docs/architecture.md walks
-// through them). Their wall times are kept in StepStats::stage_seconds.
+/// The stages of a step, in the order they run (docs/architecture.md walks
+/// through them). Their wall times are kept in StepStats::stage_seconds.
 enum class Stage : std::uint8_t {
-  Forces,     // springs, user and scripted forces into the accumulators
-  Collide,    // broadphase, narrowphase, contact cache, contact callback
-  Islands,    // waking, island building
-  BuildRows,  // joint rows and contact constraints prepared for the solver
-  Solve,      // the velocity solve and the position-correction pass
-  Integrate,  // velocities and positions
-  Store,      // impulses kept for warm starting, joint feedback and breaking
-  Events,     // contact begin/end events
-  Sleep,      // sleeping bookkeeping
-  Guards,     // the non-finite guard and the step's diagnostics
+  Forces,     ///< springs, user and scripted forces into the accumulators
+  Collide,    ///< broadphase, narrowphase, contact cache, contact callback
+  Islands,    ///< waking, island building
+  BuildRows,  ///< joint rows and contact constraints prepared for the solver
+  Solve,      ///< the velocity solve and the position-correction pass
+  Integrate,  ///< velocities and positions
+  Store,      ///< impulses kept for warm starting, joint feedback and breaking
+  Events,     ///< contact begin/end events
+  Sleep,      ///< sleeping bookkeeping
+  Guards,     ///< the non-finite guard and the step's diagnostics
   Count
 };
-inline constexpr int kStageCount = static_cast<int>(Stage::Count);
-const char* stageName(Stage s);
-
+inline constexpr int kStageCount = static_cast<int>(Stage::Count);  ///< number of stages
+const char* stageName(Stage s);  ///< lower-case name
+/// What the last step reports (World::lastStepStats).
 struct StepStats {
-  int iterations = 0;        // PGS sweeps done (summed over substeps)
-  double residual = 0;       // natural-map LCP residual after the solve (max norm, last substep)
-  int rows = 0;              // rows solved (last substep)
-  int contacts = 0;          // touching manifolds
+  int iterations = 0;        ///< PGS sweeps done (summed over substeps)
+  double residual = 0;       ///< natural-map LCP residual after the solve (max norm, last substep)
+  int rows = 0;              ///< rows solved (last substep)
+  int contacts = 0;          ///< touching manifolds
   int contact_points = 0;
-  int islands = 0;           // awake islands solved
+  int islands = 0;           ///< awake islands solved
   int sleeping_bodies = 0;
-  double max_penetration = 0;  // deepest contact after the step (m)
+  double max_penetration = 0;  ///< deepest contact after the step (m)
   int rows_by_kind[kRowKindCount] = {};
-  double stage_seconds[kStageCount] = {};  // wall time per stage (summed over substeps)
-  double wall_seconds = 0;                 // the whole step
+  double stage_seconds[kStageCount] = {};  ///< wall time per stage (summed over substeps)
+  double wall_seconds = 0;                 ///< the whole step
 };
 
-}  // namespace cairn
+}  ///< namespace cairn

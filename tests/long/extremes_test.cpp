@@ -8,7 +8,7 @@
 //   - the case's drift figure under a criterion fixed by the geometry, not
 //     by the result:
 //       stacks and columns  largest body displacement < 5 cm (a tenth of
-//                           SCENARIOS.md's 0.5 m collapse; ten 5 mm slops)
+//                           docs/scenarios.md's 0.5 m collapse; ten 5 mm slops)
 //       hanging chains      largest anchor separation < 1 cm (2% of a 0.5 m link)
 //       whipping chains     < 5 cm (5% of a 1 m link)
 //       hinges              < 1 cm

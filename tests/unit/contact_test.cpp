@@ -123,8 +123,8 @@ Real maxDisplacement(World& w, int steps, Real h, std::vector<Vec3>* start = nul
   return worst;
 }
 
-// SCENARIOS.md column-10 at the default 10 iterations and one substep
-// stands for 10 s with the top box moving under 1 cm (the figure):
+// docs/scenarios.md column-10 at the default 10 iterations and one substep
+// stands for 10 s with the top box moving under 1 cm (the requirement cairn set itself):
 // sideways under 1 mm (manifold blocks remove the per-point ordering bias
 // that makes columns rock; solver/pgs.hpp) and vertically 3 mm (NNCG's
 // momentum carries the boxes' weight down the column from the cold start;
@@ -147,7 +147,7 @@ TEST(Stacking, ColumnOfTenStandsTenSecondsAtTenIterations) {
   EXPECT_LT(total, 0.01);
 }
 
-// SCENARIOS.md pyramid-20 (210 boxes) for 10 s at 20 iterations and one
+// docs/scenarios.md pyramid-20 (210 boxes) for 10 s at 20 iterations and one
 // substep: every box within 2 cm of its start (measured 0.95 cm; plain PGS
 // reaches 2.02 cm in the cold-start settling, docs/contacts.md).
 TEST(Stacking, PyramidOfTwentyStandsTenSecondsAtTwentyIterations) {

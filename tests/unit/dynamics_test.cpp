@@ -194,7 +194,7 @@ TumbleResult tumble(Gyroscopic g, Real h, Real seconds) {
 // The default (implicit midpoint) keeps |L| and the kinetic energy to 1e-6
 // relative and the direction of L within 0.05 degree for 10 s at h = 1/60,
 // while the body flips back and forth. The invariants hold to round-off by
-// construction (dynamics/integrate.cpp); 1e-6 is the issue's bound.
+// construction (dynamics/integrate.cpp); 1e-6 is the bound cairn promises.
 TEST(Gyroscopic, ImplicitMidpointConservesEnergyAndMomentumAndFlips) {
   const TumbleResult r = tumble(Gyroscopic::ImplicitMidpoint, Real(1) / 60, 10);
   EXPECT_LT(r.max_energy_error, 1e-6);
@@ -219,7 +219,7 @@ TEST(Gyroscopic, OtherTreatmentsGainLoseOrIgnoreEnergy) {
   EXPECT_GE(ex.flips + ie.flips, 1);
 }
 
-// Issue figure: the 0.5 x 0.25 x 0.1 half-extent box at 6 rad/s near its
+// The figure cairn promises: the 0.5 x 0.25 x 0.1 half-extent box at 6 rad/s near its
 // intermediate axis loses about 30% of its energy in 20 s at h = 1/120 with
 // the implicit Euler treatment (Bullet's), and keeps it with the midpoint.
 TEST(Gyroscopic, ImplicitEulerDissipatesOnThinBoxWhereMidpointDoesNot) {

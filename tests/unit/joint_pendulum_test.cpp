@@ -75,7 +75,7 @@ TEST(HingePendulum, SmallAmplitudePeriodWithinOnePercentOfClosedForm) {
   EXPECT_NEAR(period, closed, 0.01 * closed);
 }
 
-// Large amplitude 1.5 rad: the exact period (2.517753 s, SCENARIOS.md)
+// Large amplitude 1.5 rad: the exact period (2.517753 s, docs/scenarios.md)
 // within 2%.
 TEST(HingePendulum, LargeAmplitudePeriodWithinTwoPercentOfExact) {
   const Real exact = exactPeriodRk4(1.5, kMgd / kIPivot);

@@ -99,7 +99,7 @@ TEST(BallChain, SinglePassBaumgarteGrowsUnderPlainPgsWhereTwoPassSettles) {
   EXPECT_LT(run(Correction::VelocityBias, true).end, 1e-4);
 }
 
-// Chain of 20 spheres released horizontally (SCENARIOS.md chain-20): a whip
+// Chain of 20 spheres released horizontally (docs/scenarios.md chain-20): a whip
 // whose tip passes 20 m/s. More iterations must shrink the largest anchor
 // separation; the figures go in docs/constraints.md.
 TEST(BallChain, HorizontalWhipErrorFallsWithIterations) {

@@ -1,5 +1,5 @@
-// Scene files: a valid scene loads; each bad input of the foundation and
-// constraint issues is rejected with a message naming the file, the object
+// Scene files: a valid scene loads; each bad input of the body, shape and
+// constraint fields is rejected with a message naming the file, the object
 // and the field, and the C++ API leaves the world unchanged.
 #include "cairn/error.hpp"
 #include "test_helpers.hpp"

@@ -1,4 +1,4 @@
-// PGS against the exact LCP (issue: speed/accuracy trade, point 5): on a
+// PGS against the exact LCP (the speed/accuracy trade, docs/tradeoff.md): on a
 // pyramid, the impulses PGS finds in a step approach the exact solution of
 // the same step's LCP as the sweeps grow. Distances are the velocity-norm
 // figure of validation/lcp_probe.hpp: a box resting on four points is

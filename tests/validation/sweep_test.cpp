@@ -159,7 +159,7 @@ void expectBadInput(const std::string& args, const std::string& names, const Tem
   EXPECT_FALSE(fs::exists(tmp / "bad")) << args;
 }
 
-// The issue writes the iteration list as "1,2,4,...,200": "..." continues
+// docs/tradeoff.md writes the iteration list as "1,2,4,...,200": "..." continues
 // the progression the values before it start (geometric when three share a
 // ratio, else arithmetic) below the last value, then takes the last value.
 TEST(Sweep, EllipsisContinuesTheProgression) {

@@ -26,6 +26,7 @@
 #include "collision/aabb.hpp"
 #include "collision/dynamic_tree.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -56,18 +57,39 @@ class BroadPhase {
   int proxyCount() const { return live_; }
   const DynamicTree& tree() const { return tree_; }
 
-  // Box-box overlap tests performed by all queries since the last reset.
+  // Box tests (box-box and segment-box) performed by all queries since the
+  // last reset.
   std::uint64_t overlapTests() const { return overlap_tests_; }
   void resetOverlapTests() { overlap_tests_ = 0; }
 
   // Calls visit(handle) for every proxy whose fat box overlaps `box`,
   // infinite proxies included; visit returns false to stop.
   template <class Visit>
-  void query(const Aabb& box, Visit&& visit) {
+  void query(const Aabb& box, Visit&& visit) const {
     bool go = true;
     tree_.query(box, [&](int leaf) { return go = visit(tree_.user(leaf)); }, &overlap_tests_);
     for (int h : infinite_)
       if (go && proxies_[h].fat.overlaps(box) && !visit(h)) break;
+  }
+
+  // Calls visit(handle, max_fraction) for every proxy whose fat box, grown
+  // by `extent`, meets the segment origin + f * translation, 0 <= f <=
+  // max_fraction (DynamicTree::rayCast; infinite proxies first, each tested
+  // against its own box). visit returns the new max_fraction, negative to stop.
+  template <class Visit>
+  void rayCast(const Vec3& origin, const Vec3& translation, Real max_fraction, const Vec3& extent,
+               Visit&& visit) const {
+    const Vec3 inv = translation.cwiseInverse();
+    for (int h : infinite_) {
+      ++overlap_tests_;
+      Real t0 = 0, t1 = max_fraction;
+      if (!clipLineToBox(proxies_[h].fat.lo - extent, proxies_[h].fat.hi + extent, origin, inv, t0, t1)) continue;
+      const Real f = visit(h, max_fraction);
+      if (f < 0) return;
+      max_fraction = std::min(max_fraction, f);
+    }
+    tree_.rayCast(origin, translation, max_fraction, extent,
+                  [&](int leaf, Real max_f) { return visit(tree_.user(leaf), max_f); }, &overlap_tests_);
   }
 
  private:
@@ -95,7 +117,7 @@ class BroadPhase {
   std::vector<std::pair<int, int>> fresh_;  // scratch for updatePairs
   int free_ = -1;
   int live_ = 0;
-  std::uint64_t overlap_tests_ = 0;
+  mutable std::uint64_t overlap_tests_ = 0;  // a statistic, counted by const queries too
 };
 
 }  // namespace cairn

@@ -1,0 +1,139 @@
+// Query timings over the pile-1000 scene (Google Benchmark).
+// docs/collision.md records the results and the command that produced them.
+//
+// The scene is scenarios::pile(10) as built, not settled: a 10 x 10 x 10
+// grid of 1 m boxes 0.2 m apart over a 200 x 1 x 200 ground box. Its shapes
+// go into a BroadPhase as the World puts them (tight box grown by the
+// default contact margin). Rays start at random points 2-6 m above the pile
+// and aim at random points inside its bounds, extended by half again so
+// that a ray slipping through a gap can reach a lower box or the ground;
+// the seed is fixed, so every run casts the same rays.
+//
+//   BM_RayCastPile1000/all:A  100,000 rays per iteration; A = 0 closest hit
+//                             (rayCastClosest), A = 1 every hit (rayCastAll)
+//   BM_SphereCastPile1000     10,000 sweeps of a 0.25 m sphere, closest hit
+//
+// Counters: ns_per_query (the thread's CPU time per ray or sweep, so a
+// loaded machine does not inflate it), hit_rate (fraction of
+// queries that hit something), hits_per_query (mean hits reported), and
+// box_tests_per_query (broadphase box tests: tree nodes and the ground).
+#include "bench/thread_clock.hpp"
+#include "cairn/scene.hpp"
+#include "collision/queries.hpp"
+#include "validation/scenarios.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <vector>
+
+namespace cairn::bench {
+namespace {
+
+struct PileScene {
+  std::vector<ShapeDesc> shapes;
+  std::vector<Transform> poses;
+  BroadPhase broadphase;
+
+  ShapeLookup lookup() const {
+    return [this](int user) { return QueryShape{&shapes[static_cast<size_t>(user)], poses[static_cast<size_t>(user)]}; };
+  }
+};
+
+PileScene& pile1000() {
+  static PileScene scene = [] {
+    PileScene s;
+    const SceneDesc desc = scenarios::pile(10);
+    const Real margin = SolverSettings{}.contact_margin;
+    for (const BodyDef& b : desc.bodies)
+      for (const ShapeDesc& shape : b.shapes) {
+        const Transform pose = Transform{b.position, b.orientation.normalized()} * shape.local;
+        Aabb box = shapeAabb(shape, pose);
+        if (!box.isInfinite()) box = box.expanded(margin);
+        s.broadphase.createProxy(box, static_cast<int>(s.shapes.size()));
+        s.shapes.push_back(shape);
+        s.poses.push_back(pose);
+      }
+    return s;
+  }();
+  return scene;
+}
+
+struct Segment {
+  Vec3 origin, translation;
+};
+
+// The pile's boxes fill x, z in [-5.9, 5.9] and y in [0.5, 12.3].
+std::vector<Segment> raysIntoPile(int count) {
+  std::mt19937_64 rng(20261124);
+  std::uniform_real_distribution<Real> u(0, 1);
+  auto in = [&](Real lo, Real hi) { return lo + (hi - lo) * u(rng); };
+  std::vector<Segment> rays;
+  rays.reserve(static_cast<size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    const Vec3 from(in(-8, 8), in(14.3, 18.3), in(-8, 8));
+    const Vec3 to(in(-5.9, 5.9), in(0.5, 12.3), in(-5.9, 5.9));
+    rays.push_back({from, Real(1.5) * (to - from)});
+  }
+  return rays;
+}
+
+void setCounters(benchmark::State& state, int queries, double seconds, double hits, double hit_queries,
+                 double box_tests) {
+  const double n = static_cast<double>(state.iterations()) * queries;
+  state.counters["ns_per_query"] = 1e9 * seconds / n;
+  state.counters["hit_rate"] = hit_queries / n;
+  state.counters["hits_per_query"] = hits / n;
+  state.counters["box_tests_per_query"] = box_tests / n;
+}
+
+void BM_RayCastPile1000(benchmark::State& state) {
+  constexpr int kRays = 100000;
+  PileScene& scene = pile1000();
+  static const std::vector<Segment> rays = raysIntoPile(kRays);
+  const ShapeLookup lookup = scene.lookup();
+  const bool all = state.range(0) != 0;
+  double hits = 0, hit_rays = 0;
+  scene.broadphase.resetOverlapTests();
+  const double t0 = threadSeconds();
+  for (auto _ : state) {
+    for (const Segment& r : rays) {
+      if (all) {
+        const std::vector<QueryHit> h = rayCastAll(scene.broadphase, r.origin, r.translation, lookup);
+        hits += static_cast<double>(h.size());
+        hit_rays += !h.empty();
+      } else {
+        const std::optional<QueryHit> h = rayCastClosest(scene.broadphase, r.origin, r.translation, lookup);
+        hits += h.has_value();
+        hit_rays += h.has_value();
+        benchmark::DoNotOptimize(h);
+      }
+    }
+  }
+  setCounters(state, kRays, threadSeconds() - t0, hits, hit_rays, static_cast<double>(scene.broadphase.overlapTests()));
+}
+BENCHMARK(BM_RayCastPile1000)->ArgName("all")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_SphereCastPile1000(benchmark::State& state) {
+  constexpr int kCasts = 10000;
+  PileScene& scene = pile1000();
+  static const std::vector<Segment> rays = raysIntoPile(kCasts);
+  const ShapeLookup lookup = scene.lookup();
+  const ShapeDesc sphere = ShapeDesc::sphere(0.25);
+  double hits = 0;
+  scene.broadphase.resetOverlapTests();
+  const double t0 = threadSeconds();
+  for (auto _ : state) {
+    for (const Segment& r : rays) {
+      const std::optional<QueryHit> h =
+          shapeCastClosest(scene.broadphase, sphere, Transform{r.origin, Quat::Identity()}, r.translation, lookup);
+      hits += h.has_value();
+      benchmark::DoNotOptimize(h);
+    }
+  }
+  setCounters(state, kCasts, threadSeconds() - t0, hits, hits, static_cast<double>(scene.broadphase.overlapTests()));
+}
+BENCHMARK(BM_SphereCastPile1000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace cairn::bench

@@ -74,16 +74,15 @@ inline bool clipLineToBox(const Vec3& lo, const Vec3& hi, const Vec3& o, const V
       if (o[i] < lo[i] || o[i] > hi[i]) return false;
       continue;
     }
-    Real ta = (lo[i] - o[i]) * inv_d[i], tb = (hi[i] - o[i]) * inv_d[i];
-    if (ta > tb) std::swap(ta, tb);
-    if (ta > t0) {
-      t0 = ta;
-      if (enter_axis) *enter_axis = i;
-    }
-    if (tb < t1) t1 = tb;
-    if (t0 > t1) return false;
+    // min / max rather than branches: which plane is near and whether it
+    // clips are coin flips for a tree walk's random boxes.
+    const Real ta = (lo[i] - o[i]) * inv_d[i], tb = (hi[i] - o[i]) * inv_d[i];
+    const Real near = std::min(ta, tb), far = std::max(ta, tb);
+    if (enter_axis && near > t0) *enter_axis = i;
+    t0 = std::max(t0, near);
+    t1 = std::min(t1, far);
   }
-  return true;
+  return t0 <= t1;
 }
 
 // A node waiting on a segment query's stack, with the fraction at which the

@@ -57,31 +57,34 @@ class BroadPhase {
   int proxyCount() const { return live_; }
   const DynamicTree& tree() const { return tree_; }
 
-  // Box tests (box-box and segment-box) performed by all queries since the
-  // last reset.
+  // Box-box overlap tests performed by updatePairs since the last reset.
   std::uint64_t overlapTests() const { return overlap_tests_; }
   void resetOverlapTests() { overlap_tests_ = 0; }
 
   // Calls visit(handle) for every proxy whose fat box overlaps `box`,
-  // infinite proxies included; visit returns false to stop.
+  // infinite proxies included; visit returns false to stop. Queries are
+  // const and may run concurrently: they count their box tests into *tests
+  // when given, not into overlapTests().
   template <class Visit>
-  void query(const Aabb& box, Visit&& visit) const {
+  void query(const Aabb& box, Visit&& visit, std::uint64_t* tests = nullptr) const {
     bool go = true;
-    tree_.query(box, [&](int leaf) { return go = visit(tree_.user(leaf)); }, &overlap_tests_);
+    tree_.query(box, [&](int leaf) { return go = visit(tree_.user(leaf)); }, tests);
     for (int h : infinite_)
       if (go && proxies_[h].fat.overlaps(box) && !visit(h)) break;
+    if (tests) *tests += infinite_.size();
   }
 
   // Calls visit(handle, max_fraction) for every proxy whose fat box, grown
   // by `extent`, meets the segment origin + f * translation, 0 <= f <=
   // max_fraction (DynamicTree::rayCast; infinite proxies first, each tested
-  // against its own box). visit returns the new max_fraction, negative to stop.
+  // against its own box). visit returns the new max_fraction, negative to
+  // stop. Counts box tests into *tests when given, as query() does.
   template <class Visit>
-  void rayCast(const Vec3& origin, const Vec3& translation, Real max_fraction, const Vec3& extent,
-               Visit&& visit) const {
+  void rayCast(const Vec3& origin, const Vec3& translation, Real max_fraction, const Vec3& extent, Visit&& visit,
+               std::uint64_t* tests = nullptr) const {
     const Vec3 inv = translation.cwiseInverse();
+    if (tests) *tests += infinite_.size();
     for (int h : infinite_) {
-      ++overlap_tests_;
       Real t0 = 0, t1 = max_fraction;
       if (!clipLineToBox(proxies_[h].fat.lo - extent, proxies_[h].fat.hi + extent, origin, inv, t0, t1)) continue;
       const Real f = visit(h, max_fraction);
@@ -89,7 +92,7 @@ class BroadPhase {
       max_fraction = std::min(max_fraction, f);
     }
     tree_.rayCast(origin, translation, max_fraction, extent,
-                  [&](int leaf, Real max_f) { return visit(tree_.user(leaf), max_f); }, &overlap_tests_);
+                  [&](int leaf, Real max_f) { return visit(tree_.user(leaf), max_f); }, tests);
   }
 
  private:
@@ -117,7 +120,7 @@ class BroadPhase {
   std::vector<std::pair<int, int>> fresh_;  // scratch for updatePairs
   int free_ = -1;
   int live_ = 0;
-  mutable std::uint64_t overlap_tests_ = 0;  // a statistic, counted by const queries too
+  std::uint64_t overlap_tests_ = 0;
 };
 
 }  // namespace cairn

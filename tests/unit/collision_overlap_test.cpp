@@ -89,13 +89,7 @@ TEST(Overlap, CylinderCapsSidesAndCylinderQueries) {
 }
 
 TEST(Overlap, SphereAndBoxOnAMeshQuad) {
-  auto m = std::make_shared<TriangleMeshData>();
-  m->vertices = {Vec3(-1, 0.2, -1), Vec3(-1, 0.2, 1), Vec3(1, 0.2, 1), Vec3(1, 0.2, -1)};
-  m->triangles = {{0, 1, 2}, {0, 2, 3}};
-  buildMeshBvh(*m);
-  ShapeDesc mesh;
-  mesh.type = ShapeType::Mesh;
-  mesh.mesh = m;
+  const ShapeDesc mesh = test::quadMesh();
   const Transform tm = pose(Vec3(0.5, 1, 0), rotation(-0.3, Vec3(1, 0, 0)));
   expectBoundaryAt(ShapeDesc::sphere(0.3), pose(tm.apply(Vec3(0.4, 0.5, -0.6))), tm.q * Vec3::UnitY(), mesh, tm);
   // From below: triangles are two-sided.

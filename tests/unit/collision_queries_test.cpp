@@ -61,22 +61,7 @@ Scene mixedScene() {
         const Vec3 p(1.2 * x - 1.8 + 0.1 * u(rng), 0.5 + 1.1 * y, 1.2 * z - 1.8 + 0.1 * u(rng));
         add(kinds[(x + 2 * y + 3 * z) % 5], pose(p, rotation(2 * u(rng), Vec3(u(rng), u(rng), u(rng)))));
       }
-  auto mesh = std::make_shared<TriangleMeshData>();
-  const int n = 12;
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j)
-      mesh->vertices.emplace_back(-2 + 4.0 * i / n, 0.3 + 0.2 * std::sin(1.7 * i) * std::cos(1.1 * j), -2 + 4.0 * j / n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const int a = i * (n + 1) + j;
-      mesh->triangles.push_back({a, a + 1, a + n + 2});
-      mesh->triangles.push_back({a, a + n + 2, a + n + 1});
-    }
-  buildMeshBvh(*mesh);
-  ShapeDesc m;
-  m.type = ShapeType::Mesh;
-  m.mesh = mesh;
-  add(m, pose(Vec3(5, 0, 0)));
+  add(test::meshShape(test::bumpyTerrain(12, 2, 0.2, true)), pose(Vec3(5, 0.3, 0)));
   return s;
 }
 

@@ -299,22 +299,8 @@ TEST(RayCastHull, IrregularHullHitPointIsOnTheSurfaceAndFirst) {
   EXPECT_GT(hits, 200);
 }
 
-// A 2 x 2 square in the plane y = 0.2 split along the diagonal x = z:
-// triangle 0 where z >= x, triangle 1 where x >= z, both counter-clockwise
-// seen from +y.
-ShapeDesc quadMesh() {
-  auto m = std::make_shared<TriangleMeshData>();
-  m->vertices = {Vec3(-1, 0.2, -1), Vec3(-1, 0.2, 1), Vec3(1, 0.2, 1), Vec3(1, 0.2, -1)};
-  m->triangles = {{0, 1, 2}, {0, 2, 3}};
-  buildMeshBvh(*m);
-  ShapeDesc s;
-  s.type = ShapeType::Mesh;
-  s.mesh = m;
-  return s;
-}
-
 TEST(RayCastMesh, RayDownOntoAQuadHitsTheRightTriangleFacingTheRay) {
-  const ShapeDesc mesh = quadMesh();
+  const ShapeDesc mesh = test::quadMesh();
   // (x, z) = (0.3, -0.4): x > z, the triangle (0, 2, 3).
   const auto down = castLocal(mesh, kTilted, Vec3(0.3, 1.2, -0.4), Vec3(0, -2, 0));
   ASSERT_TRUE(down);
@@ -339,30 +325,10 @@ TEST(RayCastMesh, RayDownOntoAQuadHitsTheRightTriangleFacingTheRay) {
   EXPECT_FALSE(rayCast(mesh, pose(Vec3::Zero()), Vec3(1 + 1e-9, 1, 0), Vec3(0, -2, 0)));
 }
 
-// The bumpy 40 x 40 terrain of the mesh tests (3200 triangles).
-std::shared_ptr<TriangleMeshData> terrain(bool with_bvh) {
-  auto mesh = std::make_shared<TriangleMeshData>();
-  const int n = 40;
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      const Real x = -4 + 8.0 * i / n, z = -4 + 8.0 * j / n;
-      mesh->vertices.emplace_back(x, 0.2 * std::sin(1.3 * x) * std::cos(0.9 * z), z);
-    }
-  auto id = [&](int i, int j) { return i * (n + 1) + j; };
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      mesh->triangles.push_back({id(i, j), id(i, j + 1), id(i + 1, j + 1)});
-      mesh->triangles.push_back({id(i, j), id(i + 1, j + 1), id(i + 1, j)});
-    }
-  if (with_bvh) buildMeshBvh(*mesh);
-  return mesh;
-}
-
 TEST(RayCastMesh, BvhWalkFindsTheSameFirstTriangleAsTestingEveryTriangle) {
-  ShapeDesc with, without;
-  with.type = without.type = ShapeType::Mesh;
-  with.mesh = terrain(true);
-  without.mesh = terrain(false);
+  // The 3200-triangle terrain of the mesh tests, with and without its tree.
+  const ShapeDesc with = test::meshShape(test::bumpyTerrain(40, 4, 0.2, true));
+  const ShapeDesc without = test::meshShape(test::bumpyTerrain(40, 4, 0.2, false));
   const TriangleMeshData& m = *with.mesh;
   std::mt19937 rng(11);
   std::uniform_real_distribution<Real> u(-1, 1);

@@ -287,32 +287,8 @@ TEST(ShapeCastAnyShape, TouchingAtTheStartHitsOnlyWhenPushingIn) {
     }
 }
 
-std::shared_ptr<TriangleMeshData> bumpyTerrain() {
-  auto mesh = std::make_shared<TriangleMeshData>();
-  const int n = 24;
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      const Real x = -3 + 6.0 * i / n, z = -3 + 6.0 * j / n;
-      mesh->vertices.emplace_back(x, 0.3 * std::sin(1.3 * x) * std::cos(0.9 * z), z);
-    }
-  auto id = [&](int i, int j) { return i * (n + 1) + j; };
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      mesh->triangles.push_back({id(i, j), id(i, j + 1), id(i + 1, j + 1)});
-      mesh->triangles.push_back({id(i, j), id(i + 1, j + 1), id(i + 1, j)});
-    }
-  buildMeshBvh(*mesh);
-  return mesh;
-}
-
 TEST(ShapeCastMesh, SphereOntoAFlatQuadAtTheClosedFormFraction) {
-  auto m = std::make_shared<TriangleMeshData>();
-  m->vertices = {Vec3(-1, 0.2, -1), Vec3(-1, 0.2, 1), Vec3(1, 0.2, 1), Vec3(1, 0.2, -1)};
-  m->triangles = {{0, 1, 2}, {0, 2, 3}};
-  buildMeshBvh(*m);
-  ShapeDesc mesh;
-  mesh.type = ShapeType::Mesh;
-  mesh.mesh = m;
+  const ShapeDesc mesh = test::quadMesh();
   const Transform tm = pose(Vec3(0, 1, 0), rotation(0.2, Vec3(1, 0, 0)));
   const auto hit = shapeCast(ShapeDesc::sphere(0.25), pose(tm.apply(Vec3(0.5, 2, -0.3))), tm.q * Vec3(0, -3, 0), mesh, tm);
   ASSERT_TRUE(hit);
@@ -323,9 +299,7 @@ TEST(ShapeCastMesh, SphereOntoAFlatQuadAtTheClosedFormFraction) {
 }
 
 TEST(ShapeCastMesh, BvhWalkFindsTheSameFirstTriangleAsCastingAgainstEveryTriangle) {
-  ShapeDesc mesh;
-  mesh.type = ShapeType::Mesh;
-  mesh.mesh = bumpyTerrain();
+  const ShapeDesc mesh = test::meshShape(test::bumpyTerrain(24, 3, 0.3, true));
   const TriangleMeshData& md = *mesh.mesh;
   const Transform tm = pose(Vec3(0.5, -0.2, 0), rotation(0.3, Vec3(0, 1, 0.2)));
   std::mt19937 rng(9);
@@ -342,10 +316,7 @@ TEST(ShapeCastMesh, BvhWalkFindsTheSameFirstTriangleAsCastingAgainstEveryTriangl
       auto one = std::make_shared<TriangleMeshData>();
       one->vertices = md.vertices;
       one->triangles = {md.triangles[k]};
-      ShapeDesc single;
-      single.type = ShapeType::Mesh;
-      single.mesh = one;
-      auto h = shapeCast(s, at, t, single, tm);
+      auto h = shapeCast(s, at, t, test::meshShape(one), tm);
       if (h && (!best || h->fraction < best->fraction)) best = h, best->triangle = k;
     }
     const auto got = shapeCast(s, at, t, mesh, tm);

@@ -34,7 +34,7 @@ struct PileScene {
   std::vector<Transform> poses;
   BroadPhase broadphase;
 
-  ShapeLookup lookup() const {
+  ProxyLookup lookup() const {
     return [this](int user) { return QueryShape{&shapes[static_cast<size_t>(user)], poses[static_cast<size_t>(user)]}; };
   }
 };
@@ -88,18 +88,18 @@ void BM_RayCastPile1000(benchmark::State& state) {
   constexpr int kRays = 100000;
   const PileScene& scene = pile1000();
   static const std::vector<Segment> rays = raysIntoPile(kRays);
-  const ShapeLookup lookup = scene.lookup();
+  const ProxyLookup lookup = scene.lookup();
   const bool all = state.range(0) != 0;
   double hits = 0, hit_rays = 0;
   const double t0 = threadSeconds();
   for (auto _ : state) {
     for (const Segment& r : rays) {
       if (all) {
-        const std::vector<QueryHit> h = rayCastAll(scene.broadphase, r.origin, r.translation, lookup);
+        const std::vector<ProxyHit> h = rayCastAll(scene.broadphase, r.origin, r.translation, lookup);
         hits += static_cast<double>(h.size());
         hit_rays += !h.empty();
       } else {
-        const std::optional<QueryHit> h = rayCastClosest(scene.broadphase, r.origin, r.translation, lookup);
+        const std::optional<ProxyHit> h = rayCastClosest(scene.broadphase, r.origin, r.translation, lookup);
         hits += h.has_value();
         hit_rays += h.has_value();
         benchmark::DoNotOptimize(h);
@@ -114,13 +114,13 @@ void BM_SphereCastPile1000(benchmark::State& state) {
   constexpr int kCasts = 10000;
   const PileScene& scene = pile1000();
   static const std::vector<Segment> rays = raysIntoPile(kCasts);
-  const ShapeLookup lookup = scene.lookup();
+  const ProxyLookup lookup = scene.lookup();
   const ShapeDesc sphere = ShapeDesc::sphere(0.25);
   double hits = 0;
   const double t0 = threadSeconds();
   for (auto _ : state) {
     for (const Segment& r : rays) {
-      const std::optional<QueryHit> h =
+      const std::optional<ProxyHit> h =
           shapeCastClosest(scene.broadphase, sphere, Transform{r.origin, Quat::Identity()}, r.translation, lookup);
       hits += h.has_value();
       benchmark::DoNotOptimize(h);

@@ -28,7 +28,7 @@ Transform checkedQueryShape(const char* query, const ShapeDesc& shape, const Tra
   return Transform{pose.p, pose.q.normalized()};
 }
 
-bool hitBefore(const QueryHit& a, const QueryHit& b) {
+bool hitBefore(const ProxyHit& a, const ProxyHit& b) {
   return a.hit.fraction != b.hit.fraction ? a.hit.fraction < b.hit.fraction : a.user < b.user;
 }
 
@@ -38,7 +38,7 @@ bool hitBefore(const QueryHit& a, const QueryHit& b) {
 // hit, then sorts.
 template <class Cast>
 void sweep(const BroadPhase& bp, const Vec3& origin, const Vec3& translation, const Vec3& extent, bool closest,
-           const ShapeLookup& lookup, const QueryFilter& filter, Cast&& cast, std::vector<QueryHit>& out) {
+           const ProxyLookup& lookup, const ProxyFilter& filter, Cast&& cast, std::vector<ProxyHit>& out) {
   out.clear();
   bp.rayCast(origin, translation, 1, extent, [&](int handle, Real max_f) -> Real {
     const int user = bp.user(handle);
@@ -47,7 +47,7 @@ void sweep(const BroadPhase& bp, const Vec3& origin, const Vec3& translation, co
     if (!qs.shape) return max_f;
     const std::optional<CastHit> h = cast(*qs.shape, qs.pose, max_f);
     if (!h) return max_f;
-    const QueryHit qh{user, *h};
+    const ProxyHit qh{user, *h};
     if (!closest) {
       out.push_back(qh);
       return max_f;
@@ -60,7 +60,7 @@ void sweep(const BroadPhase& bp, const Vec3& origin, const Vec3& translation, co
 }
 
 void rayCastQuery(const BroadPhase& bp, const Vec3& origin, const Vec3& translation, bool closest,
-                  const ShapeLookup& lookup, const QueryFilter& filter, std::vector<QueryHit>& out) {
+                  const ProxyLookup& lookup, const ProxyFilter& filter, std::vector<ProxyHit>& out) {
   requireFinite("ray cast", "origin", origin);
   requireFinite("ray cast", "translation", translation);
   out.clear();
@@ -71,7 +71,7 @@ void rayCastQuery(const BroadPhase& bp, const Vec3& origin, const Vec3& translat
 }
 
 void shapeCastQuery(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose_in, const Vec3& translation,
-                    bool closest, const ShapeLookup& lookup, const QueryFilter& filter, std::vector<QueryHit>& out) {
+                    bool closest, const ProxyLookup& lookup, const ProxyFilter& filter, std::vector<ProxyHit>& out) {
   const Transform pose = checkedQueryShape("shape cast", shape, pose_in);
   requireFinite("shape cast", "translation", translation);
   out.clear();
@@ -86,39 +86,39 @@ void shapeCastQuery(const BroadPhase& bp, const ShapeDesc& shape, const Transfor
 
 }  // namespace
 
-std::optional<QueryHit> rayCastClosest(const BroadPhase& bp, const Vec3& origin, const Vec3& translation,
-                                       const ShapeLookup& lookup, const QueryFilter& filter) {
-  std::vector<QueryHit> out;
+std::optional<ProxyHit> rayCastClosest(const BroadPhase& bp, const Vec3& origin, const Vec3& translation,
+                                       const ProxyLookup& lookup, const ProxyFilter& filter) {
+  std::vector<ProxyHit> out;
   rayCastQuery(bp, origin, translation, true, lookup, filter, out);
   if (out.empty()) return std::nullopt;
   return out[0];
 }
 
-std::vector<QueryHit> rayCastAll(const BroadPhase& bp, const Vec3& origin, const Vec3& translation,
-                                 const ShapeLookup& lookup, const QueryFilter& filter) {
-  std::vector<QueryHit> out;
+std::vector<ProxyHit> rayCastAll(const BroadPhase& bp, const Vec3& origin, const Vec3& translation,
+                                 const ProxyLookup& lookup, const ProxyFilter& filter) {
+  std::vector<ProxyHit> out;
   rayCastQuery(bp, origin, translation, false, lookup, filter, out);
   return out;
 }
 
-std::optional<QueryHit> shapeCastClosest(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
-                                         const Vec3& translation, const ShapeLookup& lookup,
-                                         const QueryFilter& filter) {
-  std::vector<QueryHit> out;
+std::optional<ProxyHit> shapeCastClosest(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
+                                         const Vec3& translation, const ProxyLookup& lookup,
+                                         const ProxyFilter& filter) {
+  std::vector<ProxyHit> out;
   shapeCastQuery(bp, shape, pose, translation, true, lookup, filter, out);
   if (out.empty()) return std::nullopt;
   return out[0];
 }
 
-std::vector<QueryHit> shapeCastAll(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
-                                   const Vec3& translation, const ShapeLookup& lookup, const QueryFilter& filter) {
-  std::vector<QueryHit> out;
+std::vector<ProxyHit> shapeCastAll(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
+                                   const Vec3& translation, const ProxyLookup& lookup, const ProxyFilter& filter) {
+  std::vector<ProxyHit> out;
   shapeCastQuery(bp, shape, pose, translation, false, lookup, filter, out);
   return out;
 }
 
 std::vector<int> overlapAll(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose_in,
-                            const ShapeLookup& lookup, const QueryFilter& filter) {
+                            const ProxyLookup& lookup, const ProxyFilter& filter) {
   const Transform pose = checkedQueryShape("overlap query", shape, pose_in);
   std::vector<int> out;
   bp.query(shapeAabb(shape, pose), [&](int handle) {

@@ -35,30 +35,30 @@ struct QueryShape {
   const ShapeDesc* shape = nullptr;  // nullptr: skip this proxy
   Transform pose;                    // world pose of the shape (body * local)
 };
-using ShapeLookup = std::function<QueryShape(int user)>;
-using QueryFilter = std::function<bool(int user)>;
+using ProxyLookup = std::function<QueryShape(int user)>;
+using ProxyFilter = std::function<bool(int user)>;
 
-struct QueryHit {
+struct ProxyHit {
   int user = -1;  // the proxy's user int
   CastHit hit;
 };
 
 // Segment [origin, origin + translation].
-std::optional<QueryHit> rayCastClosest(const BroadPhase& bp, const Vec3& origin, const Vec3& translation,
-                                       const ShapeLookup& lookup, const QueryFilter& filter = {});
-std::vector<QueryHit> rayCastAll(const BroadPhase& bp, const Vec3& origin, const Vec3& translation,
-                                 const ShapeLookup& lookup, const QueryFilter& filter = {});
+std::optional<ProxyHit> rayCastClosest(const BroadPhase& bp, const Vec3& origin, const Vec3& translation,
+                                       const ProxyLookup& lookup, const ProxyFilter& filter = {});
+std::vector<ProxyHit> rayCastAll(const BroadPhase& bp, const Vec3& origin, const Vec3& translation,
+                                 const ProxyLookup& lookup, const ProxyFilter& filter = {});
 
 // `shape` (convex) at `pose` swept by `translation`.
-std::optional<QueryHit> shapeCastClosest(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
-                                         const Vec3& translation, const ShapeLookup& lookup,
-                                         const QueryFilter& filter = {});
-std::vector<QueryHit> shapeCastAll(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
-                                   const Vec3& translation, const ShapeLookup& lookup, const QueryFilter& filter = {});
+std::optional<ProxyHit> shapeCastClosest(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
+                                         const Vec3& translation, const ProxyLookup& lookup,
+                                         const ProxyFilter& filter = {});
+std::vector<ProxyHit> shapeCastAll(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
+                                   const Vec3& translation, const ProxyLookup& lookup, const ProxyFilter& filter = {});
 
 // Users whose shapes `shape` (convex) at `pose` overlaps (touching counts),
 // ascending.
 std::vector<int> overlapAll(const BroadPhase& bp, const ShapeDesc& shape, const Transform& pose,
-                            const ShapeLookup& lookup, const QueryFilter& filter = {});
+                            const ProxyLookup& lookup, const ProxyFilter& filter = {});
 
 }  // namespace cairn

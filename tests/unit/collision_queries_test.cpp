@@ -27,7 +27,7 @@ struct Scene {
   std::vector<ShapeDesc> shapes;
   std::vector<Transform> poses;
 
-  ShapeLookup lookup() const {
+  ProxyLookup lookup() const {
     return [this](int user) { return QueryShape{&shapes[static_cast<size_t>(user)], poses[static_cast<size_t>(user)]}; };
   }
   // Proxies as the World makes them: tight boxes grown by a margin.
@@ -80,33 +80,33 @@ std::vector<Ray> randomRays(int count, unsigned seed) {
   return rays;
 }
 
-bool sameHit(const QueryHit& a, const QueryHit& b) {
+bool sameHit(const ProxyHit& a, const ProxyHit& b) {
   return a.user == b.user && a.hit.fraction == b.hit.fraction && a.hit.normal == b.hit.normal &&
          a.hit.point == b.hit.point && a.hit.triangle == b.hit.triangle && a.hit.inside == b.hit.inside;
 }
 
 // Every shape tested one by one, sorted by fraction then user.
 template <class Cast>
-std::vector<QueryHit> bruteForce(const Scene& s, const QueryFilter& filter, Cast&& cast) {
-  std::vector<QueryHit> all;
+std::vector<ProxyHit> bruteForce(const Scene& s, const ProxyFilter& filter, Cast&& cast) {
+  std::vector<ProxyHit> all;
   for (int i = 0; i < static_cast<int>(s.shapes.size()); ++i) {
     if (filter && !filter(i)) continue;
     if (const auto h = cast(s.shapes[static_cast<size_t>(i)], s.poses[static_cast<size_t>(i)])) all.push_back({i, *h});
   }
-  std::sort(all.begin(), all.end(), [](const QueryHit& a, const QueryHit& b) {
+  std::sort(all.begin(), all.end(), [](const ProxyHit& a, const ProxyHit& b) {
     return a.hit.fraction != b.hit.fraction ? a.hit.fraction < b.hit.fraction : a.user < b.user;
   });
   return all;
 }
 
-void expectSameClosest(const std::optional<QueryHit>& got, const std::vector<QueryHit>& want) {
+void expectSameClosest(const std::optional<ProxyHit>& got, const std::vector<ProxyHit>& want) {
   ASSERT_EQ(got.has_value(), !want.empty());
   if (got) {
     EXPECT_TRUE(sameHit(*got, want[0]));
   }
 }
 
-void expectSameList(const std::vector<QueryHit>& got, const std::vector<QueryHit>& want) {
+void expectSameList(const std::vector<ProxyHit>& got, const std::vector<ProxyHit>& want) {
   ASSERT_EQ(got.size(), want.size());
   for (size_t k = 0; k < got.size(); ++k)
     EXPECT_TRUE(sameHit(got[k], want[k])) << k << ": user " << got[k].user << " vs " << want[k].user << ", fraction "
@@ -137,7 +137,7 @@ TEST(QueryRayCast, ClosestAndAllEqualTestingEveryShapeInAnyInsertionOrder) {
 TEST(QueryRayCast, FilterLeavesOutTheRejectedShapesOnly) {
   const Scene s = mixedScene();
   const BroadPhase bp = s.broadphase(false);
-  const QueryFilter odd = [](int user) { return user % 2 == 1; };  // no ground plane
+  const ProxyFilter odd = [](int user) { return user % 2 == 1; };  // no ground plane
   for (const Ray& r : randomRays(200, 2)) {
     const auto want = bruteForce(s, odd, [&](const ShapeDesc& d, const Transform& t) {
       return rayCast(d, t, r.origin, r.translation);

@@ -1,24 +1,26 @@
-// Query timings over the pile-1000 scene (Google Benchmark).
-// docs/collision.md records the results and the command that produced them.
+// Query timings over the pile-1000 scene through the World's public
+// queries (Google Benchmark). docs/collision.md records the results and the
+// command that produced them.
 //
 // The scene is scenarios::pile(10) as built, not settled: a 10 x 10 x 10
-// grid of 1 m boxes 0.2 m apart over a 200 x 1 x 200 ground box. Its shapes
-// go into a BroadPhase as the World puts them (tight box grown by the
-// default contact margin). Rays start at random points 2-6 m above the pile
-// and aim at random points inside its bounds, extended by half again so
-// that a ray slipping through a gap can reach a lower box or the ground;
-// the seed is fixed, so every run casts the same rays.
+// grid of 1 m boxes 0.2 m apart over a 200 x 1 x 200 ground box, in a World
+// (buildWorld), whose broadphase holds each shape's box grown by the
+// contact margin. Rays start at random points 2-6 m above the pile and aim
+// at random points inside its bounds, extended by half again so that a ray
+// slipping through a gap can reach a lower box or the ground; the seed is
+// fixed, so every run casts the same rays.
 //
 //   BM_RayCastPile1000/all:A  100,000 rays per iteration; A = 0 closest hit
-//                             (rayCastClosest), A = 1 every hit (rayCastAll)
+//                             (World::castRay), A = 1 every hit (castRayAll)
 //   BM_SphereCastPile1000     10,000 sweeps of a 0.25 m sphere, closest hit
+//                             (World::castShape)
 //
 // Counters: ns_per_query (the thread's CPU time per ray or sweep, so a
 // loaded machine does not inflate it), hit_rate (fraction of queries that
 // hit something) and hits_per_query (mean hits reported).
 #include "bench/thread_clock.hpp"
 #include "cairn/scene.hpp"
-#include "collision/queries.hpp"
+#include "cairn/world.hpp"
 #include "validation/scenarios.hpp"
 
 #include <benchmark/benchmark.h>
@@ -29,33 +31,9 @@
 namespace cairn::bench {
 namespace {
 
-struct PileScene {
-  std::vector<ShapeDesc> shapes;
-  std::vector<Transform> poses;
-  BroadPhase broadphase;
-
-  ProxyLookup lookup() const {
-    return [this](int user) { return QueryShape{&shapes[static_cast<size_t>(user)], poses[static_cast<size_t>(user)]}; };
-  }
-};
-
-const PileScene& pile1000() {
-  static const PileScene scene = [] {
-    PileScene s;
-    const SceneDesc desc = scenarios::pile(10);
-    const Real margin = SolverSettings{}.contact_margin;
-    for (const BodyDef& b : desc.bodies)
-      for (const ShapeDesc& shape : b.shapes) {
-        const Transform pose = Transform{b.position, b.orientation.normalized()} * shape.local;
-        Aabb box = shapeAabb(shape, pose);
-        if (!box.isInfinite()) box = box.expanded(margin);
-        s.broadphase.createProxy(box, static_cast<int>(s.shapes.size()));
-        s.shapes.push_back(shape);
-        s.poses.push_back(pose);
-      }
-    return s;
-  }();
-  return scene;
+const World& pile1000() {
+  static const World world = buildWorld(scenarios::pile(10));
+  return world;
 }
 
 struct Segment {
@@ -86,20 +64,19 @@ void setCounters(benchmark::State& state, int queries, double seconds, double hi
 
 void BM_RayCastPile1000(benchmark::State& state) {
   constexpr int kRays = 100000;
-  const PileScene& scene = pile1000();
+  const World& world = pile1000();
   static const std::vector<Segment> rays = raysIntoPile(kRays);
-  const ProxyLookup lookup = scene.lookup();
   const bool all = state.range(0) != 0;
   double hits = 0, hit_rays = 0;
   const double t0 = threadSeconds();
   for (auto _ : state) {
     for (const Segment& r : rays) {
       if (all) {
-        const std::vector<ProxyHit> h = rayCastAll(scene.broadphase, r.origin, r.translation, lookup);
+        const std::vector<RayHit> h = world.castRayAll(r.origin, r.translation);
         hits += static_cast<double>(h.size());
         hit_rays += !h.empty();
       } else {
-        const std::optional<ProxyHit> h = rayCastClosest(scene.broadphase, r.origin, r.translation, lookup);
+        const std::optional<RayHit> h = world.castRay(r.origin, r.translation);
         hits += h.has_value();
         hit_rays += h.has_value();
         benchmark::DoNotOptimize(h);
@@ -112,16 +89,14 @@ BENCHMARK(BM_RayCastPile1000)->ArgName("all")->Arg(0)->Arg(1)->Unit(benchmark::k
 
 void BM_SphereCastPile1000(benchmark::State& state) {
   constexpr int kCasts = 10000;
-  const PileScene& scene = pile1000();
+  const World& world = pile1000();
   static const std::vector<Segment> rays = raysIntoPile(kCasts);
-  const ProxyLookup lookup = scene.lookup();
   const ShapeDesc sphere = ShapeDesc::sphere(0.25);
   double hits = 0;
   const double t0 = threadSeconds();
   for (auto _ : state) {
     for (const Segment& r : rays) {
-      const std::optional<ProxyHit> h =
-          shapeCastClosest(scene.broadphase, sphere, Transform{r.origin, Quat::Identity()}, r.translation, lookup);
+      const std::optional<ShapeCastHit> h = world.castShape(sphere, Transform{r.origin, Quat::Identity()}, r.translation);
       hits += h.has_value();
       benchmark::DoNotOptimize(h);
     }

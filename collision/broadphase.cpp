@@ -89,6 +89,32 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
   return true;
 }
 
+std::vector<BroadPhase::ProxyState> BroadPhase::proxyStates() const {
+  std::vector<ProxyState> out;
+  out.reserve(proxies_.size());
+  for (const Proxy& p : proxies_) out.push_back({p.fat, p.user, p.next_free, p.alive});
+  return out;
+}
+
+void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) {
+  *this = BroadPhase(margin_, displacement_multiplier_);
+  proxies_.resize(proxies.size());
+  for (size_t i = 0; i < proxies.size(); ++i) {
+    const int h = static_cast<int>(i);
+    Proxy& p = proxies_[i];
+    p.fat = proxies[i].fat;
+    p.user = proxies[i].user;
+    p.next_free = proxies[i].next_free;
+    p.alive = proxies[i].alive;
+    if (!p.alive) continue;
+    ++live_;
+    if (p.fat.isInfinite()) infinite_.push_back(h);
+    else p.leaf = tree_.insert(p.fat, h);
+    markMoved(h);
+  }
+  free_ = free_head;
+}
+
 void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
   // 1. Pairs found by querying each moved proxy. A pair of two moved
   //    proxies is found twice; keep it from the lower handle's query.

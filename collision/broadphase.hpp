@@ -51,6 +51,24 @@ class BroadPhase {
   // handles with lo < hi, sorted. `out` is overwritten.
   void updatePairs(std::vector<std::pair<int, int>>& out);
 
+  // The broadphase as plain data (snapshots, world/snapshot_state.cpp):
+  // per handle its fat box, user, liveness and free-list link, and the head
+  // of the free list. restore() rebuilds from that: the same handles, fat
+  // boxes and free list, a tree built by inserting the live finite proxies
+  // in handle order, and every live proxy queued for updatePairs, which so
+  // finds exactly the pairs of overlapping fat boxes the original held.
+  // The tree's shape may differ, which no result depends on (pairs and
+  // query answers are sorted).
+  struct ProxyState {
+    Aabb fat;
+    int user = -1;
+    int next_free = -1;
+    bool alive = false;
+  };
+  std::vector<ProxyState> proxyStates() const;
+  int freeHead() const { return free_; }
+  void restore(const std::vector<ProxyState>& proxies, int free_head);
+
   int user(int handle) const { return proxies_[handle].user; }
   const Aabb& fatAabb(int handle) const { return proxies_[handle].fat; }
   bool isInfinite(int handle) const { return proxies_[handle].leaf < 0; }

@@ -63,6 +63,14 @@ void requireFinite(const std::string& obj, const std::string& field, const Vec3&
   if (!v.allFinite()) throw InputError(obj, field, "must be finite");
 }
 
+bool isSymmetricPositiveDefinite(const Mat3& m) {
+  if (!m.allFinite() || !m.isApprox(m.transpose(), Real(1e-9))) return false;
+  Eigen::SelfAdjointEigenSolver<Mat3> es(m);
+  return es.eigenvalues().minCoeff() > 0;
+}
+
+}  // namespace
+
 void validateShape(const std::string& obj, const std::string& f, const ShapeDesc& s, BodyType type) {
   requireFinite(obj, f + ".position", s.local.p);
   if (!s.local.q.coeffs().allFinite() || s.local.q.norm() < Real(1e-9))
@@ -96,14 +104,6 @@ void validateShape(const std::string& obj, const std::string& f, const ShapeDesc
       break;
   }
 }
-
-bool isSymmetricPositiveDefinite(const Mat3& m) {
-  if (!m.allFinite() || !m.isApprox(m.transpose(), Real(1e-9))) return false;
-  Eigen::SelfAdjointEigenSolver<Mat3> es(m);
-  return es.eigenvalues().minCoeff() > 0;
-}
-
-}  // namespace
 
 void validateSettings(const SolverSettings& s) {
   const std::string o = "solver";

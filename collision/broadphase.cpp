@@ -73,7 +73,14 @@ void BroadPhase::destroyProxy(int h) {
 
 bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
   Proxy& p = proxies_[h];
-  if (p.leaf < 0) return false;  // infinite proxies pair with everything already
+  if (p.leaf < 0) {
+    // An infinite proxy (a plane) keeps the box it is given: a moved plane's
+    // half-space bounds something else.
+    if (p.fat.lo == tight.lo && p.fat.hi == tight.hi) return false;
+    p.fat = tight;
+    markMoved(h);
+    return true;
+  }
   const Aabb want = fatten(tight, displacement);
   bool reinsert = !p.fat.contains(tight);
   if (!reinsert) {

@@ -44,7 +44,8 @@ class BroadPhase {
   // motion over the next step (v * dt), zero for static shapes.
   int createProxy(const Aabb& tight, int user, const Vec3& displacement = Vec3::Zero());
   void destroyProxy(int handle);
-  // Returns true when the fat box changed (the proxy was re-inserted).
+  // Returns true when the fat box changed (the proxy was re-inserted). An
+  // infinite proxy takes `tight` as it is.
   bool moveProxy(int handle, const Aabb& tight, const Vec3& displacement = Vec3::Zero());
 
   // Every pair of proxies whose fat boxes overlap, each once as (lo, hi)

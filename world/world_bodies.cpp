@@ -189,6 +189,11 @@ void WorldImpl::recomputeMass(Body& b, const std::string& obj) {
   for (auto& sh : shapes) sh.local.p += b.com_local;
   Vec3 com_local = Vec3::Zero();
   if (b.type == BodyType::Dynamic) {
+    // Checked here, not only at creation: a static or kinematic body's
+    // definition may carry a mass that only counts once it turns dynamic.
+    if (b.def_mass && b.def_density) throw InputError(obj, "mass", "give mass or density, not both");
+    if (b.def_mass) requirePositive(obj, "mass", *b.def_mass);
+    if (b.def_density) requirePositive(obj, "density", *b.def_density);
     Real volume = 0;
     for (const auto& sh : shapes) volume += shapeVolume(sh);
     MassProperties mp;

@@ -55,7 +55,8 @@ void WorldImpl::moveProxies(BodyId only, Real h) {
     const Body& b = body(ref.body);
     if (only.isWorld() && (b.type == BodyType::Static || b.asleep)) continue;
     const ShapeDesc& shape = b.shapes[static_cast<size_t>(ref.index)];
-    const Aabb box = shapeAabb(shape, b.transform() * shape.local).expanded(reach(b, settings_.contact_margin, h));
+    Aabb box = shapeAabb(shape, b.transform() * shape.local);
+    if (!box.isInfinite()) box = box.expanded(reach(b, settings_.contact_margin, h));  // as registerShape does
     broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
   }
 }

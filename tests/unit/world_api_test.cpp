@@ -260,5 +260,51 @@ TEST(WorldApi, JointedBodyTurnedStaticOrKinematicStepsWithoutNaN) {
   }
 }
 
+// A static body's definition may carry a mass it does not use; turning it
+// dynamic uses it, so a bad one is refused then, and the body stays static.
+TEST(WorldApi, TurningDynamicChecksTheMassTheDefinitionCarried) {
+  World w;
+  BodyDef d;
+  d.name = "post";
+  d.type = BodyType::Static;
+  d.mass = -1;
+  d.inertia = Mat3::Identity();
+  const BodyId post = w.createBody(d);
+  try {
+    w.setType(post, BodyType::Dynamic);
+    FAIL() << "a negative mass became dynamic";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "mass") << e.what();
+  }
+  EXPECT_EQ(w.type(post), BodyType::Static);
+  EXPECT_EQ(w.mass(post), kInf);
+}
+
+// A static body teleported under a falling ball catches it where it now
+// is: the broadphase follows the teleport (a stale box would let the ball
+// fall through), and a teleported floor plane likewise. The balls come to
+// rest 0.5 m above the surfaces, less the penetration the slop allows.
+TEST(WorldApi, TeleportedStaticBodiesCollideWhereTheyNowAre) {
+  World w;
+  BodyDef shelf = test::boxDef("shelf", Vec3(50, 0, 0));
+  shelf.type = BodyType::Static;
+  shelf.mass.reset();
+  const BodyId s = w.createBody(shelf);
+  BodyDef floor;
+  floor.name = "floor";
+  floor.type = BodyType::Static;
+  floor.shapes.push_back(ShapeDesc::plane(Vec3::UnitY(), -20));
+  const BodyId f = w.createBody(floor);
+  const BodyId ball = w.createBody(test::sphereDef("ball", Vec3(0, 6, 0), 1, 0.5));
+  const BodyId ball2 = w.createBody(test::sphereDef("ball2", Vec3(10, 6, 0), 1, 0.5));
+  w.step(kH);
+  w.setTransform(s, Vec3(0, 2.5, 0), Quat::Identity());  // box top at y = 3
+  w.setTransform(f, Vec3(0, 20, 0), Quat::Identity());   // the floor plane up to y = 0
+  for (int i = 0; i < 180; ++i) w.step(kH);
+  const Real slop = w.settings().slop;  // resting contacts keep up to this penetration
+  EXPECT_NEAR(w.centerOfMass(ball).y(), 3.5, slop + 1e-6);
+  EXPECT_NEAR(w.centerOfMass(ball2).y(), 0.5, slop + 1e-6);
+}
+
 }  // namespace
 }  // namespace cairn

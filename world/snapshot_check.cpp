@@ -98,6 +98,10 @@ class Checker {
       const std::string f = "joints[" + std::to_string(i) + "]";
       require(bodyOrWorld(j.def.body_a) && bodyOrWorld(j.def.body_b), f, "the joint's bodies are not live bodies");
       require(j.warm.size() == static_cast<size_t>(kMaxJointRows), f, "the warm-start impulses have the wrong count");
+      require(j.local_motor_axes.size() == j.def.motor_axes.size() &&
+                  j.def.motor_targets.size() >= j.def.motor_axes.size() &&
+                  j.def.motor_max_torques.size() >= j.def.motor_axes.size(),
+              f, "the motor axes, targets and torques differ in number");
       validateJointDef(j.def, w_.bodySlots());
     }
   }

@@ -134,9 +134,13 @@ void io(Ar& ar, ConvexHullData& h) {
     const auto inRange = [n](int v) { return v >= 0 && v < n; };
     if (h.face_normals.size() != h.faces.size() || h.face_offsets.size() != h.faces.size())
       ar.fail("a hull's faces, normals and offsets differ in number");
-    for (const auto& f : h.faces)
+    for (const auto& f : h.faces) {
+      if (f.size() < 3) ar.fail("a hull face has fewer than 3 vertices");
       for (int v : f)
         if (!inRange(v)) ar.fail("a hull face names a vertex it does not have");
+    }
+    for (const Vec3& v : h.vertices)
+      if (!v.allFinite()) ar.fail("a hull vertex is not finite");
     for (const auto& e : h.edges)
       if (!inRange(e[0]) || !inRange(e[1])) ar.fail("a hull edge names a vertex it does not have");
   }

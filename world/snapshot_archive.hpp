@@ -11,7 +11,7 @@
 //
 // The reader never reads past the end (a truncated payload throws
 // InputError naming the snapshot and what was being read) and never
-// allocates more elements than the bytes left could hold.
+// allocates for more elements than the data holds.
 #pragma once
 
 #include "cairn/error.hpp"
@@ -154,11 +154,22 @@ void io(Ar& ar, std::optional<T>& o) {
   }
   if (has) io(ar, *o);
 }
+// A vector, each element through `each`. Read element by element, so a
+// corrupted count costs no more memory than the elements the data holds.
+template <class Ar, class T, class Each>
+void ioEach(Ar& ar, std::vector<T>& v, Each&& each) {
+  if constexpr (Ar::reading) {
+    const size_t n = ar.count(1);
+    v.clear();
+    for (size_t i = 0; i < n; ++i) each(v.emplace_back());
+  } else {
+    ar(static_cast<std::uint64_t>(v.size()));
+    for (auto& x : v) each(x);
+  }
+}
 template <class Ar, class T>
 void io(Ar& ar, std::vector<T>& v) {
-  if constexpr (Ar::reading) v.resize(ar.count(1));
-  else ar(static_cast<std::uint64_t>(v.size()));
-  for (auto& x : v) io(ar, x);
+  ioEach(ar, v, [&ar](T& x) { io(ar, x); });
 }
 
 }  // namespace cairn::detail

@@ -166,17 +166,15 @@ void io(Ar& ar, TriangleMeshData& m) {
 
 template <class Ar, class Data>
 void ioTable(Ar& ar, std::vector<std::shared_ptr<const Data>>& table) {
-  if constexpr (Ar::reading) {
-    table.resize(ar.count(1));
-    for (auto& entry : table) {
+  ioEach(ar, table, [&ar](std::shared_ptr<const Data>& entry) {
+    if constexpr (Ar::reading) {
       auto data = std::make_shared<Data>();
       io(ar, *data);
       entry = std::move(data);
+    } else {
+      io(ar, const_cast<Data&>(*entry));  // the writer only reads
     }
-  } else {
-    ar(static_cast<std::uint64_t>(table.size()));
-    for (const auto& entry : table) io(ar, const_cast<Data&>(*entry));
-  }
+  });
 }
 
 template <class Ar, class Data>
@@ -270,9 +268,7 @@ void io(Ar& ar, Body& b, const SharedGeometry& g) {
   ar(b.asleep);
   ar(b.sleeping_allowed);
   ar(b.sleep_timer);
-  if constexpr (Ar::reading) b.shapes.resize(ar.count(1));
-  else ar(static_cast<std::uint64_t>(b.shapes.size()));
-  for (ShapeDesc& s : b.shapes) io(ar, s, g);
+  ioEach(ar, b.shapes, [&](ShapeDesc& s) { io(ar, s, g); });
   io(ar, b.shape_ids);
   io(ar, b.def_mass);
   io(ar, b.def_density);
@@ -493,9 +489,7 @@ void ioWorld(Ar& ar, WorldImpl& w) {
   ar.at("meshes");
   ioTable(ar, g.meshes);
   ar.at("bodies");
-  if constexpr (Ar::reading) w.bodies_.resize(ar.count(1));
-  else ar(static_cast<std::uint64_t>(w.bodies_.size()));
-  for (Body& b : w.bodies_) io(ar, b, g);
+  ioEach(ar, w.bodies_, [&](Body& b) { io(ar, b, g); });
   io(ar, w.free_bodies_);
   ar(w.alive_bodies_);
   ar.at("springs");

@@ -10,23 +10,17 @@
 //                    the thread does not inflate it.
 //   BM_Step*         a whole World::step (rows, warm start, PGS, the
 //                    position-correction pass, integration, feedback)
+#include "bench/thread_clock.hpp"
 #include "solver/pgs.hpp"
 #include "validation/scenarios.hpp"
 #include "world/world_access.hpp"
 
 #include <benchmark/benchmark.h>
 
-#include <ctime>
 #include <vector>
 
 namespace cairn::bench {
 namespace {
-
-double threadSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
 
 struct PgsProblem {
   std::vector<ConstraintRow> rows;

@@ -1,6 +1,10 @@
 // `cairn run SCENE.json [--steps N] [--dt H] [--out traj.csv] [--every K]
 //  [--metrics m.json] [--method pgs|direct|lcp] [--substeps N]
-//  [--iterations N]`: simulate a scene and write its trajectory.
+//  [--iterations N] [--save-state FILE]`: simulate a scene and write its
+// trajectory; `cairn run --restore FILE --steps N [...]` goes on from a
+// snapshot that --save-state wrote (docs/snapshots.md), bit-identically.
+// Trajectory rows are numbered by the world's step count, so a restored
+// run's rows continue the saved run's.
 #include "cli/commands.hpp"
 #include "cli/solver_overrides.hpp"
 #include "cairn/error.hpp"
@@ -23,6 +27,7 @@ namespace {
 
 struct RunOptions {
   std::string scene;
+  std::string restore, save_state;
   std::optional<int> steps;
   std::optional<double> dt;
   std::string out;
@@ -132,8 +137,20 @@ void writeAtomically(const std::string& path, const std::string& content) {
 
 int runScene(const RunOptions& opt) {
   SceneDesc scene;
+  World world;
+  const std::string& source = opt.restore.empty() ? opt.scene : opt.restore;
   try {
-    scene = loadScene(opt.scene);
+    if (opt.scene.empty() == opt.restore.empty()) throw InputError("", "", "give a scene file or --restore FILE (one of them)");
+    if (!opt.restore.empty()) {
+      // The snapshot's world, its settings and its last step size.
+      if (!opt.steps) throw InputError("--steps", "", "is required with --restore");
+      world.restoreSnapshot(opt.restore);
+      scene.solver = world.settings();
+      scene.dt = cairn::detail::internals(world).stepContext().h;
+      if (!(scene.dt > 0) && !opt.dt) throw InputError("--dt", "", "is required: the snapshot was taken before any step");
+    } else {
+      scene = loadScene(opt.scene);
+    }
     if (opt.steps) {
       if (*opt.steps < 0) throw InputError("--steps", "", "must be >= 0");
       scene.steps = *opt.steps;
@@ -144,20 +161,22 @@ int runScene(const RunOptions& opt) {
     }
     if (opt.every < 1) throw InputError("--every", "", "must be >= 1");
     applySolverOverrides(opt.solver, scene);
+    if (opt.restore.empty()) world = buildWorld(scene);
+    else world.setSettings(scene.solver);
   } catch (const InputError& e) {
     std::cerr << "cairn run: " << e.what() << "\n";
     return 2;
   }
-  World world = buildWorld(scene);
 
   std::string csv;
   if (!opt.out.empty()) {
     csv = "step,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
-    appendRows(csv, world, 0);
+    appendRows(csv, world, world.stepCount());
   }
+  const int first_step = world.stepCount();  // 0, or the snapshot's
   const Real e0 = world.kineticEnergy() + world.potentialEnergy();
   RunFigures fig;
-  fig.last_second_from = scene.steps * scene.dt - 1;
+  fig.last_second_from = world.time() + scene.steps * scene.dt - 1;
   const auto t0 = std::chrono::steady_clock::now();
   int status = 0;
   for (int s = 1; s <= scene.steps; ++s) {
@@ -165,24 +184,25 @@ int runScene(const RunOptions& opt) {
     fig.record(world);
     if (!world.numericalEvents().empty()) {
       const auto& ev = world.numericalEvents().front();
-      std::cerr << "cairn run: " << opt.scene << ": body '" << ev.body_name << "': non-finite state in "
-                << ev.stage << " at step " << s << "; stopped\n";
+      std::cerr << "cairn run: " << source << ": body '" << ev.body_name << "': non-finite state in "
+                << ev.stage << " at step " << world.stepCount() << "; stopped\n";
       status = 3;
       break;
     }
-    if (!opt.out.empty() && s % opt.every == 0) appendRows(csv, world, s);
+    if (!opt.out.empty() && s % opt.every == 0) appendRows(csv, world, world.stepCount());
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const Diagnostic& d : world.diagnostics())
-    std::cerr << "cairn run: " << opt.scene << ": body '" << d.body_name << "': " << d.kind << " in " << d.count
+    std::cerr << "cairn run: " << source << ": body '" << d.body_name << "': " << d.kind << " in " << d.count
               << " (sub)steps from step " << d.first_step + 1 << ": " << d.detail << "\n";
   if (status != 0) return status;
 
   try {
     if (!opt.out.empty()) writeAtomically(opt.out, csv);
+    if (!opt.save_state.empty()) world.saveSnapshot(opt.save_state);
     if (!opt.metrics.empty()) {
       nlohmann::json m;
-      m["scene"] = opt.scene;
+      m["scene"] = source;
       m["steps"] = world.stepCount();
       m["dt"] = scene.dt;
       m["method"] = solverMethodName(scene.solver.method);
@@ -190,7 +210,7 @@ int runScene(const RunOptions& opt) {
       m["iterations"] = scene.solver.iterations;
       m["body_count"] = world.bodyCount();
       m["wall_time_s"] = wall;
-      m["wall_time_per_step_ms"] = world.stepCount() ? 1e3 * wall / world.stepCount() : 0.0;
+      m["wall_time_per_step_ms"] = world.stepCount() > first_step ? 1e3 * wall / (world.stepCount() - first_step) : 0.0;
       m["energy_initial"] = e0;
       nlohmann::json diags = nlohmann::json::array();
       for (const Diagnostic& d : world.diagnostics())
@@ -205,8 +225,9 @@ int runScene(const RunOptions& opt) {
     std::cerr << "cairn run: " << e.what() << "\n";
     return 2;
   }
-  std::cout << opt.scene << ": " << world.stepCount() << " steps of " << scene.dt << " s, "
-            << world.bodyCount() << " bodies, " << 1e3 * wall / std::max(1, world.stepCount()) << " ms/step\n";
+  std::cout << source << ": " << world.stepCount() << " steps of " << scene.dt << " s, "
+            << world.bodyCount() << " bodies, " << 1e3 * wall / std::max(1, world.stepCount() - first_step)
+            << " ms/step\n";
   return 0;
 }
 
@@ -215,12 +236,14 @@ int runScene(const RunOptions& opt) {
 void addRunCommand(CLI::App& app, int& status) {
   auto opt = std::make_shared<RunOptions>();
   CLI::App* run = app.add_subcommand("run", "Simulate a scene file and write its trajectory");
-  run->add_option("scene", opt->scene, "Scene JSON file")->required();
+  run->add_option("scene", opt->scene, "Scene JSON file (or --restore)");
   run->add_option("--steps", opt->steps, "Number of steps (overrides the file)");
   run->add_option("--dt", opt->dt, "Time step in seconds (overrides the file)");
   run->add_option("--out", opt->out, "Trajectory CSV to write");
   run->add_option("--every", opt->every, "Record every K-th step (default 1)");
   run->add_option("--metrics", opt->metrics, "Metrics JSON to write");
+  run->add_option("--save-state", opt->save_state, "Snapshot of the world after the run to write");
+  run->add_option("--restore", opt->restore, "Go on from this snapshot instead of a scene (needs --steps)");
   addSolverOverrideOptions(*run, opt->solver);
   run->callback([opt, &status] { status = runScene(*opt); });
 }

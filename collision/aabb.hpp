@@ -20,6 +20,8 @@
 #include "cairn/math.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 
 namespace cairn {
 
@@ -55,6 +57,49 @@ struct Aabb {
     return Real(2) * (e.x() * e.y() + e.y() * e.z() + e.z() * e.x());
   }
 };
+
+// Slab test (Kay and Kajiya, "Ray Tracing Complex Scenes", SIGGRAPH 1986):
+// clips the parameter interval [t0, t1] of the line o + t d to the box
+// [lo, hi]; false when the interval becomes empty. Per axis the line is
+// between the two slab planes for t between (lo_i - o_i) / d_i and
+// (hi_i - o_i) / d_i; `inv_d` is 1 / d componentwise, and a non-finite
+// component (d_i = 0) keeps the interval when lo_i <= o_i <= hi_i and
+// empties it otherwise (closed slabs: a line along a face touches the box).
+// enter_axis (optional) receives the axis whose near plane last raised t0,
+// left alone when none did.
+inline bool clipLineToBox(const Vec3& lo, const Vec3& hi, const Vec3& o, const Vec3& inv_d, Real& t0, Real& t1,
+                          int* enter_axis = nullptr) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(inv_d[i])) {
+      if (o[i] < lo[i] || o[i] > hi[i]) return false;
+      continue;
+    }
+    // min / max rather than branches: which plane is near and whether it
+    // clips are coin flips for a tree walk's random boxes.
+    const Real ta = (lo[i] - o[i]) * inv_d[i], tb = (hi[i] - o[i]) * inv_d[i];
+    const Real near = std::min(ta, tb), far = std::max(ta, tb);
+    if (enter_axis && near > t0) *enter_axis = i;
+    t0 = std::max(t0, near);
+    t1 = std::min(t1, far);
+  }
+  return t0 <= t1;
+}
+
+// A node waiting on a segment query's stack, with the fraction at which the
+// segment enters its box.
+struct SegmentEntry {
+  int node;
+  Real enter;
+};
+
+// Pushes two children met by a segment, the farther first so that the nearer
+// is popped (and can clip the segment) first; a child entered beyond
+// max_fraction is dropped. On a tie `a` counts as the nearer.
+inline void pushNearerLast(SegmentEntry* stack, int& top, SegmentEntry a, SegmentEntry b, Real max_fraction) {
+  if (b.enter < a.enter) std::swap(a, b);
+  if (b.enter <= max_fraction) stack[top++] = b;
+  if (a.enter <= max_fraction) stack[top++] = a;
+}
 
 // World bounds of `shape` placed at `t` (t already includes shape.local).
 Aabb shapeAabb(const ShapeDesc& shape, const Transform& t);

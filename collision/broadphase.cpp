@@ -73,7 +73,14 @@ void BroadPhase::destroyProxy(int h) {
 
 bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
   Proxy& p = proxies_[h];
-  if (p.leaf < 0) return false;  // infinite proxies pair with everything already
+  if (p.leaf < 0) {
+    // An infinite proxy (a plane) keeps the box it is given: a moved plane's
+    // half-space bounds something else.
+    if (p.fat.lo == tight.lo && p.fat.hi == tight.hi) return false;
+    p.fat = tight;
+    markMoved(h);
+    return true;
+  }
   const Aabb want = fatten(tight, displacement);
   bool reinsert = !p.fat.contains(tight);
   if (!reinsert) {
@@ -87,6 +94,32 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
   tree_.update(p.leaf, want);
   markMoved(h);
   return true;
+}
+
+std::vector<BroadPhase::ProxyState> BroadPhase::proxyStates() const {
+  std::vector<ProxyState> out;
+  out.reserve(proxies_.size());
+  for (const Proxy& p : proxies_) out.push_back({p.fat, p.user, p.next_free, p.alive});
+  return out;
+}
+
+void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) {
+  *this = BroadPhase(margin_, displacement_multiplier_);
+  proxies_.resize(proxies.size());
+  for (size_t i = 0; i < proxies.size(); ++i) {
+    const int h = static_cast<int>(i);
+    Proxy& p = proxies_[i];
+    p.fat = proxies[i].fat;
+    p.user = proxies[i].user;
+    p.next_free = proxies[i].next_free;
+    p.alive = proxies[i].alive;
+    if (!p.alive) continue;
+    ++live_;
+    if (p.fat.isInfinite()) infinite_.push_back(h);
+    else p.leaf = tree_.insert(p.fat, h);
+    markMoved(h);
+  }
+  free_ = free_head;
 }
 
 void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {

@@ -26,6 +26,7 @@
 #include "collision/aabb.hpp"
 #include "collision/dynamic_tree.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -43,12 +44,31 @@ class BroadPhase {
   // motion over the next step (v * dt), zero for static shapes.
   int createProxy(const Aabb& tight, int user, const Vec3& displacement = Vec3::Zero());
   void destroyProxy(int handle);
-  // Returns true when the fat box changed (the proxy was re-inserted).
+  // Returns true when the fat box changed (the proxy was re-inserted). An
+  // infinite proxy takes `tight` as it is.
   bool moveProxy(int handle, const Aabb& tight, const Vec3& displacement = Vec3::Zero());
 
   // Every pair of proxies whose fat boxes overlap, each once as (lo, hi)
   // handles with lo < hi, sorted. `out` is overwritten.
   void updatePairs(std::vector<std::pair<int, int>>& out);
+
+  // The broadphase as plain data (snapshots, world/snapshot_state.cpp):
+  // per handle its fat box, user, liveness and free-list link, and the head
+  // of the free list. restore() rebuilds from that: the same handles, fat
+  // boxes and free list, a tree built by inserting the live finite proxies
+  // in handle order, and every live proxy queued for updatePairs, which so
+  // finds exactly the pairs of overlapping fat boxes the original held.
+  // The tree's shape may differ, which no result depends on (pairs and
+  // query answers are sorted).
+  struct ProxyState {
+    Aabb fat;
+    int user = -1;
+    int next_free = -1;
+    bool alive = false;
+  };
+  std::vector<ProxyState> proxyStates() const;
+  int freeHead() const { return free_; }
+  void restore(const std::vector<ProxyState>& proxies, int free_head);
 
   int user(int handle) const { return proxies_[handle].user; }
   const Aabb& fatAabb(int handle) const { return proxies_[handle].fat; }
@@ -56,18 +76,42 @@ class BroadPhase {
   int proxyCount() const { return live_; }
   const DynamicTree& tree() const { return tree_; }
 
-  // Box-box overlap tests performed by all queries since the last reset.
+  // Box-box overlap tests performed by updatePairs since the last reset.
   std::uint64_t overlapTests() const { return overlap_tests_; }
   void resetOverlapTests() { overlap_tests_ = 0; }
 
   // Calls visit(handle) for every proxy whose fat box overlaps `box`,
-  // infinite proxies included; visit returns false to stop.
+  // infinite proxies included; visit returns false to stop. Queries are
+  // const and may run concurrently: they count their box tests into *tests
+  // when given, not into overlapTests().
   template <class Visit>
-  void query(const Aabb& box, Visit&& visit) {
+  void query(const Aabb& box, Visit&& visit, std::uint64_t* tests = nullptr) const {
     bool go = true;
-    tree_.query(box, [&](int leaf) { return go = visit(tree_.user(leaf)); }, &overlap_tests_);
+    tree_.query(box, [&](int leaf) { return go = visit(tree_.user(leaf)); }, tests);
     for (int h : infinite_)
       if (go && proxies_[h].fat.overlaps(box) && !visit(h)) break;
+    if (tests) *tests += infinite_.size();
+  }
+
+  // Calls visit(handle, max_fraction) for every proxy whose fat box, grown
+  // by `extent`, meets the segment origin + f * translation, 0 <= f <=
+  // max_fraction (DynamicTree::rayCast; infinite proxies first, each tested
+  // against its own box). visit returns the new max_fraction, negative to
+  // stop. Counts box tests into *tests when given, as query() does.
+  template <class Visit>
+  void rayCast(const Vec3& origin, const Vec3& translation, Real max_fraction, const Vec3& extent, Visit&& visit,
+               std::uint64_t* tests = nullptr) const {
+    const Vec3 inv = translation.cwiseInverse();
+    if (tests) *tests += infinite_.size();
+    for (int h : infinite_) {
+      Real t0 = 0, t1 = max_fraction;
+      if (!clipLineToBox(proxies_[h].fat.lo - extent, proxies_[h].fat.hi + extent, origin, inv, t0, t1)) continue;
+      const Real f = visit(h, max_fraction);
+      if (f < 0) return;
+      max_fraction = std::min(max_fraction, f);
+    }
+    tree_.rayCast(origin, translation, max_fraction, extent,
+                  [&](int leaf, Real max_f) { return visit(tree_.user(leaf), max_f); }, tests);
   }
 
  private:

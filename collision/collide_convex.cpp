@@ -20,12 +20,14 @@
 
 namespace cairn::narrow {
 
-bool convexProxies(const ConvexProxy& a, const ConvexProxy& b, Real margin, Manifold& m) {
+bool convexSeparation(const ConvexProxy& a, const ConvexProxy& b, Real margin, Separation& out) {
   const Real ra = a.radius, rb = b.radius;
   const GjkResult g = gjkDistance(a, b, false, ra + rb + margin);
   if (g.beyond) return false;
-  Vec3 n, wa, wb;
-  Real depth;
+  Vec3& n = out.normal;
+  Vec3& wa = out.point_a;
+  Vec3& wb = out.point_b;
+  Real& depth = out.depth;
   if (!g.overlap) {
     if (g.distance - ra - rb > margin) return false;
     n = (g.point_b - g.point_a) / g.distance;
@@ -53,7 +55,13 @@ bool convexProxies(const ConvexProxy& a, const ConvexProxy& b, Real margin, Mani
       depth = n.dot(wa - wb);
     }
   }
-  return buildManifold(a, b, n, depth, wa, wb, margin, m);
+  return true;
+}
+
+bool convexProxies(const ConvexProxy& a, const ConvexProxy& b, Real margin, Manifold& m) {
+  Separation s;
+  if (!convexSeparation(a, b, margin, s)) return false;
+  return buildManifold(a, b, s.normal, s.depth, s.point_a, s.point_b, margin, m);
 }
 
 int convexConvex(const ShapeDesc& a, const Transform& ta, const ShapeDesc& b, const Transform& tb, Real margin, Out& out) {

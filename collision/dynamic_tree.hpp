@@ -26,6 +26,7 @@
 
 #include "collision/aabb.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -81,6 +82,45 @@ class DynamicTree {
         stack[top++] = n.child1;
         stack[top++] = n.child2;
       }
+    }
+    if (tests) *tests += count;
+  }
+
+  // Segment query (Box2D's b2DynamicTree_RayCast and b2DynamicTree_ShapeCast,
+  // with slab tests): calls visit(leaf, max_fraction) for every leaf whose
+  // box, grown by `extent` on every side, meets the segment
+  //   origin + f * translation, 0 <= f <= max_fraction.
+  // visit returns the new max_fraction: a hit's fraction clips the segment
+  // and prunes every node it no longer reaches; a negative value stops. Of
+  // two children the nearer (smaller entry fraction) is visited first, so a
+  // closest-hit query clips early. Adds the number of node tests to *tests.
+  template <class Visit>
+  void rayCast(const Vec3& origin, const Vec3& translation, Real max_fraction, const Vec3& extent, Visit&& visit,
+               std::uint64_t* tests = nullptr) const {
+    if (root_ < 0) return;
+    const Vec3 inv = translation.cwiseInverse();
+    auto enter = [&](int i) {
+      Real t0 = 0, t1 = max_fraction;
+      const Aabb& b = nodes_[i].box;
+      return clipLineToBox(b.lo - extent, b.hi + extent, origin, inv, t0, t1) ? t0 : kInf;
+    };
+    SegmentEntry stack[128];  // depth-first: at most one pending sibling per level
+    int top = 0;
+    std::uint64_t count = 1;
+    const Real f_root = enter(root_);
+    if (f_root <= max_fraction) stack[top++] = {root_, f_root};
+    while (top > 0) {
+      const SegmentEntry e = stack[--top];
+      if (e.enter > max_fraction) continue;  // clipped since it was pushed
+      const Node& n = nodes_[e.node];
+      if (n.isLeaf()) {
+        const Real f = visit(e.node, max_fraction);
+        if (f < 0) break;
+        max_fraction = std::min(max_fraction, f);
+        continue;
+      }
+      count += 2;
+      pushNearerLast(stack, top, {n.child1, enter(n.child1)}, {n.child2, enter(n.child2)}, max_fraction);
     }
     if (tests) *tests += count;
   }

@@ -136,6 +136,18 @@ bool solveTetrahedron(Simplex& s, Vec3& v) {
 
 }  // namespace
 
+bool nearestOnSimplex(Simplex& s, Vec3& v) {
+  switch (s.count) {
+    case 1:
+      s.lambda[0] = 1;
+      v = s.v[0].w;
+      return true;
+    case 2: v = solveSegment(s); return true;
+    case 3: v = solveTriangle(s); return true;
+    default: return solveTetrahedron(s, v);
+  }
+}
+
 GjkResult gjkDistance(const ConvexProxy& pa, const ConvexProxy& pb, bool full, Real max_distance) {
   GjkResult r;
   Simplex& s = r.simplex;
@@ -167,19 +179,9 @@ GjkResult gjkDistance(const ConvexProxy& pa, const ConvexProxy& pb, bool full, R
     if (s.count > 0 && (repeated || v2 - vw <= eps * v2)) break;
 
     s.v[s.count++] = w;
-    switch (s.count) {
-      case 1:
-        s.lambda[0] = 1;
-        v = w.w;
-        break;
-      case 2: v = solveSegment(s); break;
-      case 3: v = solveTriangle(s); break;
-      case 4:
-        if (!solveTetrahedron(s, v)) {
-          r.overlap = true;
-          return r;
-        }
-        break;
+    if (!nearestOnSimplex(s, v)) {
+      r.overlap = true;
+      return r;
     }
     const Real nv2 = v.squaredNorm();
     if (nv2 <= touch2) {

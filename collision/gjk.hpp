@@ -45,6 +45,12 @@ struct GjkResult {
   int iterations = 0;
 };
 
+// The point v of conv(s) nearest the origin (the Voronoi region tests
+// above): reduces s to the vertices whose hull holds v and sets their
+// weights. False, leaving s as it was, when s is a tetrahedron that encloses
+// the origin.
+bool nearestOnSimplex(Simplex& s, Vec3& v);
+
 // full = false runs on the cores (sphere: center, capsule: segment) and
 // reports their distance; the caller subtracts the radii.
 GjkResult gjkDistance(const ConvexProxy& a, const ConvexProxy& b, bool full, Real max_distance = kInf);

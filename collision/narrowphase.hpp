@@ -25,6 +25,16 @@ int convexConvex(const ShapeDesc& a, const Transform& ta, const ShapeDesc& b, co
 // Mesh first; b is any convex shape.
 int meshConvex(const ShapeDesc& mesh, const Transform& tm, const ShapeDesc& b, const Transform& tb, Real margin, Out& out);
 
+// Normal (unit, from A toward B), depth (> 0 penetrating, < 0 apart) and the
+// two surface points of two convex proxies, by GJK on the cores or EPA
+// (collide_convex.cpp). False when farther apart than margin.
+struct Separation {
+  Vec3 normal = Vec3::UnitY();
+  Real depth = 0;
+  Vec3 point_a = Vec3::Zero(), point_b = Vec3::Zero();
+};
+bool convexSeparation(const ConvexProxy& a, const ConvexProxy& b, Real margin, Separation& out);
+
 // The GJK / EPA path on proxies (also used for mesh triangles and as the
 // fallback of the dedicated routines). False when farther than margin.
 bool convexProxies(const ConvexProxy& a, const ConvexProxy& b, Real margin, Manifold& m);

@@ -69,6 +69,7 @@ void World::setTransform(BodyId id, const Vec3& position, const Quat& orientatio
   b.orientation = orientation.normalized();
   b.position = position + b.orientation * b.com_local;
   b.updateDerived();
+  impl_->moveProxies(id, 0);  // queries see it where it now is
   impl_->wakeBody(id);
   for (const Contact& c : impl_->contacts()) {  // what it touched may fall
     const BodyId other = c.body_a.index == id.index ? c.body_b : (c.body_b.index == id.index ? c.body_a : kWorldBody);

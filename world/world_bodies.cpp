@@ -63,6 +63,14 @@ void requireFinite(const std::string& obj, const std::string& field, const Vec3&
   if (!v.allFinite()) throw InputError(obj, field, "must be finite");
 }
 
+bool isSymmetricPositiveDefinite(const Mat3& m) {
+  if (!m.allFinite() || !m.isApprox(m.transpose(), Real(1e-9))) return false;
+  Eigen::SelfAdjointEigenSolver<Mat3> es(m);
+  return es.eigenvalues().minCoeff() > 0;
+}
+
+}  // namespace
+
 void validateShape(const std::string& obj, const std::string& f, const ShapeDesc& s, BodyType type) {
   requireFinite(obj, f + ".position", s.local.p);
   if (!s.local.q.coeffs().allFinite() || s.local.q.norm() < Real(1e-9))
@@ -96,14 +104,6 @@ void validateShape(const std::string& obj, const std::string& f, const ShapeDesc
       break;
   }
 }
-
-bool isSymmetricPositiveDefinite(const Mat3& m) {
-  if (!m.allFinite() || !m.isApprox(m.transpose(), Real(1e-9))) return false;
-  Eigen::SelfAdjointEigenSolver<Mat3> es(m);
-  return es.eigenvalues().minCoeff() > 0;
-}
-
-}  // namespace
 
 void validateSettings(const SolverSettings& s) {
   const std::string o = "solver";
@@ -189,6 +189,11 @@ void WorldImpl::recomputeMass(Body& b, const std::string& obj) {
   for (auto& sh : shapes) sh.local.p += b.com_local;
   Vec3 com_local = Vec3::Zero();
   if (b.type == BodyType::Dynamic) {
+    // Checked here, not only at creation: a static or kinematic body's
+    // definition may carry a mass that only counts once it turns dynamic.
+    if (b.def_mass && b.def_density) throw InputError(obj, "mass", "give mass or density, not both");
+    if (b.def_mass) requirePositive(obj, "mass", *b.def_mass);
+    if (b.def_density) requirePositive(obj, "density", *b.def_density);
     Real volume = 0;
     for (const auto& sh : shapes) volume += shapeVolume(sh);
     MassProperties mp;

@@ -49,6 +49,18 @@ void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
   b.shape_ids[static_cast<size_t>(index_in_body)] = slot;
 }
 
+void WorldImpl::moveProxies(BodyId only, Real h) {
+  for (const ShapeRef& ref : shapes_) {
+    if (!ref.alive || (!only.isWorld() && ref.body.index != only.index)) continue;
+    const Body& b = body(ref.body);
+    if (only.isWorld() && (b.type == BodyType::Static || b.asleep)) continue;
+    const ShapeDesc& shape = b.shapes[static_cast<size_t>(ref.index)];
+    Aabb box = shapeAabb(shape, b.transform() * shape.local);
+    if (!box.isInfinite()) box = box.expanded(reach(b, settings_.contact_margin, h));  // as registerShape does
+    broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
+  }
+}
+
 void WorldImpl::setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution) {
   if (!std::isfinite(friction) || friction < 0) throw InputError("pair material", "friction", "must be finite and >= 0");
   if (!std::isfinite(restitution) || restitution < 0 || restitution > 1)
@@ -94,14 +106,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
   std::vector<Contact>& old_contacts_ = w.old_contacts_;
   const auto body = [&](BodyId id) -> const Body& { return w.body(id); };
   // 1. Broadphase: move the proxies of bodies that can move.
-  for (const ShapeRef& ref : w.shapes_) {
-    if (!ref.alive) continue;
-    const Body& b = body(ref.body);
-    if (b.type == BodyType::Static || b.asleep) continue;
-    const Transform t = b.transform() * b.shapes[static_cast<size_t>(ref.index)].local;
-    const Aabb box = shapeAabb(b.shapes[static_cast<size_t>(ref.index)], t).expanded(reach(b, settings_.contact_margin, h));
-    broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
-  }
+  w.moveProxies(kWorldBody, h);
   broadphase_.updatePairs(w.pairs_);
 
   // 2. Narrowphase over the candidate pairs, matching last step's contacts.

@@ -28,6 +28,7 @@
 #include "solver/worker_pool.hpp"
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -224,6 +225,17 @@ class WorldImpl {
   Real potentialEnergy() const;
   Vec3 linearMomentum() const;
 
+  // --- Queries (world/world_queries.cpp)
+  std::optional<RayHit> castRay(const Vec3& origin, const Vec3& translation, const QueryFilter& f) const;
+  std::vector<RayHit> castRayAll(const Vec3& origin, const Vec3& translation, const QueryFilter& f) const;
+  std::optional<ShapeCastHit> castShape(const ShapeDesc& shape, const Transform& pose, const Vec3& translation,
+                                        const QueryFilter& f) const;
+  std::vector<ShapeId> overlap(const ShapeDesc& shape, const Transform& pose, const QueryFilter& f) const;
+  // Moves the proxies of the body's shapes (or, for kWorldBody, of every
+  // awake body that can move) so their fat boxes hold the shapes where they
+  // are now, stretched along v h (world/world_contacts.cpp).
+  void moveProxies(BodyId only, Real h);
+
   // ----------------------------------------------------------------------
   // The state itself. The step's stages (world/*.cpp) work on these.
   Vec3 gravity_ = Vec3(0, Real(-9.81), 0);
@@ -276,5 +288,8 @@ class WorldImpl {
 }  // namespace detail
 
 void validateSettings(const SolverSettings& s);
+// A shape definition of a body of `type` (throws InputError naming `obj`
+// and `field`; world/world_bodies.cpp).
+void validateShape(const std::string& obj, const std::string& field, const ShapeDesc& s, BodyType type);
 
 }  // namespace cairn

@@ -191,10 +191,14 @@ class World {
   std::optional<RayHit> castRay(const Vec3& origin, const Vec3& translation, const QueryFilter& filter = {}) const;
   /// Every hit along the segment, nearest first.
   std::vector<RayHit> castRayAll(const Vec3& origin, const Vec3& translation, const QueryFilter& filter = {}) const;
-  /// The first hit of a sphere, box or capsule at `pose` swept by `translation`.
+  /// The first hit of a convex shape (sphere, box, capsule, cylinder, convex
+  /// hull) at `pose` swept by `translation`.
   std::optional<ShapeCastHit> castShape(const ShapeDesc& shape, const Transform& pose, const Vec3& translation,
                                         const QueryFilter& filter = {}) const;
-  /// The shapes a query shape at `pose` overlaps.
+  /// The shapes a convex query shape at `pose` overlaps or touches, by
+  /// ascending shape slot. Bad input (non-finite values, a plane or mesh as
+  /// the query shape, a bad dimension) throws InputError (docs/collision.md,
+  /// "Queries").
   std::vector<ShapeId> overlap(const ShapeDesc& shape, const Transform& pose, const QueryFilter& filter = {}) const;
 
   // --- Settings -------------------------------------------------------------------

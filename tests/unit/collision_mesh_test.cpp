@@ -9,26 +9,8 @@
 namespace cairn {
 namespace {
 
-// A bumpy 40 x 40 grid of quads (3200 triangles) over [-4, 4]^2, heights
-// from a smooth function so that neighbouring triangles differ.
-std::shared_ptr<TriangleMeshData> terrain(bool with_bvh) {
-  auto mesh = std::make_shared<TriangleMeshData>();
-  const int n = 40;
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      const Real x = -4 + 8.0 * i / n, z = -4 + 8.0 * j / n;
-      mesh->vertices.emplace_back(x, 0.2 * std::sin(1.3 * x) * std::cos(0.9 * z), z);
-    }
-  auto id = [&](int i, int j) { return i * (n + 1) + j; };
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      // Counter-clockwise seen from above (+y).
-      mesh->triangles.push_back({id(i, j), id(i, j + 1), id(i + 1, j + 1)});
-      mesh->triangles.push_back({id(i, j), id(i + 1, j + 1), id(i + 1, j)});
-    }
-  if (with_bvh) buildMeshBvh(*mesh);
-  return mesh;
-}
+// The bumpy 40 x 40 terrain (3200 triangles) over [-4, 4]^2.
+std::shared_ptr<TriangleMeshData> terrain(bool with_bvh) { return test::bumpyTerrain(40, 4, 0.2, with_bvh); }
 
 TEST(CollisionMeshBvh, CoversEveryTriangleOnceAndBoundsItsLeaves) {
   const auto mesh = terrain(true);

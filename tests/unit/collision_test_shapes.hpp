@@ -4,8 +4,10 @@
 
 #include "collision/hull.hpp"
 #include "collision/manifold.hpp"
+#include "collision/mesh_bvh.hpp"
 #include "collision/support.hpp"
 
+#include <memory>
 #include <random>
 
 namespace cairn::test {
@@ -33,6 +35,44 @@ inline ShapeDesc blobHull() {
   std::vector<Vec3> p;
   for (int i = 0; i < 20; ++i) p.push_back(Vec3(g(rng), g(rng), g(rng)).normalized().cwiseProduct(Vec3(0.6, 0.45, 0.5)));
   return hullShape(p);
+}
+
+inline ShapeDesc meshShape(std::shared_ptr<const TriangleMeshData> mesh) {
+  ShapeDesc s;
+  s.type = ShapeType::Mesh;
+  s.mesh = std::move(mesh);
+  return s;
+}
+
+// A bumpy n x n grid of quads (2 n^2 triangles) over [-half, half]^2, heights
+// amplitude * sin(1.3 x) cos(0.9 z) so that neighbouring triangles differ,
+// counter-clockwise seen from above (+y).
+inline std::shared_ptr<TriangleMeshData> bumpyTerrain(int n, Real half, Real amplitude, bool with_bvh) {
+  auto mesh = std::make_shared<TriangleMeshData>();
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const Real x = -half + 2 * half * i / n, z = -half + 2 * half * j / n;
+      mesh->vertices.emplace_back(x, amplitude * std::sin(1.3 * x) * std::cos(0.9 * z), z);
+    }
+  auto id = [&](int i, int j) { return i * (n + 1) + j; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      mesh->triangles.push_back({id(i, j), id(i, j + 1), id(i + 1, j + 1)});
+      mesh->triangles.push_back({id(i, j), id(i + 1, j + 1), id(i + 1, j)});
+    }
+  if (with_bvh) buildMeshBvh(*mesh);
+  return mesh;
+}
+
+// A 2 x 2 square in the plane y = 0.2 split along the diagonal x = z:
+// triangle 0 where z >= x, triangle 1 where x >= z, both counter-clockwise
+// seen from +y.
+inline ShapeDesc quadMesh() {
+  auto m = std::make_shared<TriangleMeshData>();
+  m->vertices = {Vec3(-1, 0.2, -1), Vec3(-1, 0.2, 1), Vec3(1, 0.2, 1), Vec3(1, 0.2, -1)};
+  m->triangles = {{0, 1, 2}, {0, 2, 3}};
+  buildMeshBvh(*m);
+  return meshShape(m);
 }
 
 // Exact signed distance from world point x to the surface of s at t

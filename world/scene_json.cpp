@@ -13,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
 namespace cairn {
@@ -281,19 +282,32 @@ BodyDef parseBody(const json& j, size_t index, const Context& ctx) {
   return b;
 }
 
-BodyId bodyRef(const Reader& r, const SceneDesc& scene, const json& v, const std::string& field) {
+// Body names to indices, so that each reference of a joint or spring is
+// found in constant time (a linear search per reference is quadratic in a
+// large scene). The first of two bodies with the same name wins here; the
+// World refuses the second.
+using BodyNames = std::unordered_map<std::string, int>;
+
+BodyNames bodyNames(const SceneDesc& scene) {
+  BodyNames names;
+  names.reserve(scene.bodies.size());
+  for (size_t i = 0; i < scene.bodies.size(); ++i) names.emplace(scene.bodies[i].name, static_cast<int>(i));
+  return names;
+}
+
+BodyId bodyRef(const Reader& r, const BodyNames& names, const json& v, const std::string& field) {
   if (!v.is_string()) r.fail(field, "must be a body name or \"world\"");
   const std::string name = v.get<std::string>();
   if (name == "world") return kWorldBody;
-  const int idx = scene.bodyIndex(name);
-  if (idx < 0) r.fail(field, "no body named '" + name + "'");
-  return BodyId{idx};
+  const auto it = names.find(name);
+  if (it == names.end()) r.fail(field, "no body named '" + name + "'");
+  return BodyId{it->second};
 }
 
-std::pair<BodyId, BodyId> bodyPair(const Reader& r, const SceneDesc& scene) {
+std::pair<BodyId, BodyId> bodyPair(const Reader& r, const BodyNames& names) {
   const json& v = r.required("bodies", "[a, b] with body names or \"world\"");
   if (!v.is_array() || v.size() != 2) r.fail("bodies", "must be [a, b] with body names or \"world\"");
-  return {bodyRef(r, scene, v[0], "bodies[0]"), bodyRef(r, scene, v[1], "bodies[1]")};
+  return {bodyRef(r, names, v[0], "bodies[0]"), bodyRef(r, names, v[1], "bodies[1]")};
 }
 
 Softness parseSoftness(const Reader& r) {
@@ -331,13 +345,13 @@ JointType jointType(const Reader& r, const std::string& t) {
   r.fail("type", "unknown joint type '" + t + "' (ball, hinge, slider, fixed, universal, cone_twist, distance, angular_motor)");
 }
 
-JointDef parseJoint(const json& j, size_t index, const SceneDesc& scene) {
+JointDef parseJoint(const json& j, size_t index, const BodyNames& names) {
   Reader r(j, objectLabel("joint", j, index));
   const std::string& object = r.object();
   JointDef d;
   d.name = r.name("name", "joint" + std::to_string(index));
   d.type = jointType(r, r.string("type"));
-  std::tie(d.body_a, d.body_b) = bodyPair(r, scene);
+  std::tie(d.body_a, d.body_b) = bodyPair(r, names);
   if (d.type == JointType::Distance) {
     const json& a = r.required("anchors", "a distance joint needs two world points [[x,y,z],[x,y,z]]");
     if (!a.is_array() || a.size() != 2) r.fail("anchors", "must be two world points [[x,y,z],[x,y,z]]");
@@ -502,6 +516,7 @@ SceneDesc parseScene(const std::string& text, const std::string& path, const Inp
       scene.bodies.reserve(bodies.size());
       for (size_t i = 0; i < bodies.size(); ++i) scene.bodies.push_back(parseBody(bodies[i], i, ctx));
     }
+    const BodyNames names = bodyNames(scene);
     if (r.has("springs")) {
       const json& springs = r.array("springs", "an array of springs");
       checkCount(r, "springs", springs, limits.springs, "springs");
@@ -509,7 +524,7 @@ SceneDesc parseScene(const std::string& text, const std::string& path, const Inp
         Reader s(springs[i], objectLabel("spring", springs[i], i));
         SpringDef d;
         d.name = s.name("name", "spring" + std::to_string(i));
-        std::tie(d.body_a, d.body_b) = bodyPair(s, scene);
+        std::tie(d.body_a, d.body_b) = bodyPair(s, names);
         const json& a = s.required("anchors", "two world points [[x,y,z],[x,y,z]]");
         if (!a.is_array() || a.size() != 2) s.fail("anchors", "must be two world points [[x,y,z],[x,y,z]]");
         d.anchor_a = s.vec3Of(a[0], "anchors[0]");
@@ -524,7 +539,7 @@ SceneDesc parseScene(const std::string& text, const std::string& path, const Inp
     if (r.has("joints")) {
       const json& joints = r.array("joints", "an array of joints");
       checkCount(r, "joints", joints, limits.joints, "joints");
-      for (size_t i = 0; i < joints.size(); ++i) scene.joints.push_back(parseJoint(joints[i], i, scene));
+      for (size_t i = 0; i < joints.size(); ++i) scene.joints.push_back(parseJoint(joints[i], i, names));
     }
     if (r.has("validation")) scene.validation_json = r.required("validation", "an object").dump();
     (void)r.string("description", "");

@@ -19,17 +19,17 @@
 namespace cairn {
 
 struct InputLimits {
-  std::uint64_t bodies = 100000;           // bodies in a scene
+  std::uint64_t bodies = 10000;            // bodies in a scene
   std::uint64_t shapes_per_body = 1000;    // shapes of one (compound) body
-  std::uint64_t joints = 100000;           // joints in a scene
+  std::uint64_t joints = 10000;            // joints in a scene
   std::uint64_t springs = 100000;          // springs in a scene
   std::uint64_t hull_points = 10000;       // input points of one convex hull
   std::uint64_t mesh_vertices = 3000000;   // `v` records of one OBJ file
   std::uint64_t mesh_triangles = 1000000;  // triangles of one OBJ file (after fanning)
   std::uint64_t json_depth = 64;           // nesting of arrays and objects in a scene file
   std::uint64_t file_bytes = 256u << 20;   // size of a scene or OBJ file (256 MiB)
-  std::uint64_t iterations = 100000;       // solver.iterations (sweeps per (sub)step)
-  std::uint64_t substeps = 10000;          // solver.substeps
+  std::uint64_t iterations = 10000;        // solver.iterations (sweeps per (sub)step)
+  std::uint64_t substeps = 1000;           // solver.substeps
 };
 
 // Ranges of values a step can carry in double precision, checked when a

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <string>
 
 namespace cairn {
@@ -185,24 +186,24 @@ TEST(SceneRefusal, CountsBeyondTheLimitsAreRefusedWithTheLimitsName) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
     }
   };
-  InputLimits l;
-  l.bodies = 2;
-  refusedWith(kScene, l, "big.json: scene: field 'bodies': 3 entries exceed the limit (limit bodies = 2; raise it with --limit bodies=N");
-  l = {};
-  l.shapes_per_body = 0;
-  refusedWith(kScene, l, "field 'shapes': 1 entries exceed the limit (limit shapes_per_body = 0");
-  l = {};
-  l.springs = 0;
-  refusedWith(kScene, l, "(limit springs = 0");
-  l = {};
-  l.joints = 0;
-  refusedWith(kScene, l, "(limit joints = 0");
-  l = {};
-  l.iterations = 19;
-  refusedWith(kScene, l, "solver: field 'iterations': 20 exceeds the limit (limit iterations = 19");
-  l = {};
-  l.file_bytes = 100;
-  refusedWith(kScene, l, "bytes exceed the limit (limit file_bytes = 100");
+  const struct {
+    std::uint64_t InputLimits::*limit;
+    std::uint64_t value;
+    const char* message;
+  } cases[] = {
+      {&InputLimits::bodies, 2,
+       "big.json: scene: field 'bodies': 3 entries exceed the limit (limit bodies = 2; raise it with --limit bodies=N"},
+      {&InputLimits::shapes_per_body, 0, "field 'shapes': 1 entries exceed the limit (limit shapes_per_body = 0"},
+      {&InputLimits::springs, 0, "(limit springs = 0"},
+      {&InputLimits::joints, 0, "(limit joints = 0"},
+      {&InputLimits::iterations, 19, "solver: field 'iterations': 20 exceeds the limit (limit iterations = 19"},
+      {&InputLimits::file_bytes, 100, "bytes exceed the limit (limit file_bytes = 100"},
+  };
+  for (const auto& c : cases) {
+    InputLimits l;
+    l.*c.limit = c.value;
+    refusedWith(kScene, l, c.message);
+  }
 }
 
 TEST(SceneRefusal, OnlyRegularFilesAreReadAsScenes) {

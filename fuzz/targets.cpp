@@ -4,7 +4,7 @@
 #include "collision/obj_mesh.hpp"
 #include "collision/triangle_area.hpp"
 #include "world/scene_json.hpp"
-#include "world/world.hpp"
+#include "cairn/world.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -22,9 +22,10 @@ namespace {
   std::abort();
 }
 
-bool finiteState(const Body& b) {
-  return b.position.allFinite() && b.orientation.coeffs().allFinite() && b.linear_velocity.allFinite() &&
-         b.angular_velocity.allFinite();
+bool finiteState(const World& w, BodyId id) {
+  const Transform t = w.transform(id);
+  return t.p.allFinite() && t.q.coeffs().allFinite() && w.linearVelocity(id).allFinite() &&
+         w.angularVelocity(id).allFinite();
 }
 
 }  // namespace
@@ -52,8 +53,8 @@ Outcome sceneInput(const std::uint8_t* data, std::size_t size) {
     World world = buildWorld(scene);
     for (int s = 0; s < kSteps; ++s) {
       world.step(scene.dt);
-      for (const Body& b : world.bodies())
-        if (!finiteState(b)) broken("a body's state is not finite after a step");
+      for (const BodyId id : world.bodies())
+        if (!finiteState(world, id)) broken("a body's state is not finite after a step");
     }
     return Outcome::Loaded;
   } catch (const InputError&) {

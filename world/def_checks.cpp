@@ -126,6 +126,18 @@ void checkBodyDef(const BodyDef& def, const std::string& obj, const InputLimits&
   magnitude(obj, "torsional_friction", def.torsional_friction);
   magnitude(obj, "linear_damping", def.linear_damping);
   magnitude(obj, "angular_damping", def.angular_damping);
+  magnitude(obj, "force", def.force);
+  magnitude(obj, "torque", def.torque);
+  for (size_t i = 0; i < def.impulses.size(); ++i) {
+    const std::string f = "impulses[" + std::to_string(i) + "]";
+    magnitude(obj, f + ".time", def.impulses[i].time);
+    magnitude(obj, f + ".impulse", def.impulses[i].impulse);
+    if (def.impulses[i].point) magnitude(obj, f + ".point", *def.impulses[i].point);
+  }
+  for (size_t i = 0; i < def.lock_translation.size(); ++i)
+    magnitude(obj, "lock_translation[" + std::to_string(i) + "]", def.lock_translation[i]);
+  for (size_t i = 0; i < def.lock_rotation.size(); ++i)
+    magnitude(obj, "lock_rotation[" + std::to_string(i) + "]", def.lock_rotation[i]);
   for (size_t i = 0; i < def.shapes.size(); ++i) shape(obj, "shapes[" + std::to_string(i) + "]", def.shapes[i]);
 }
 

@@ -5,7 +5,7 @@
 // carry, nesting and counts beyond the input limits.
 #include "cairn/error.hpp"
 #include "world/scene_json.hpp"
-#include "world/world.hpp"
+#include "cairn/world.hpp"
 
 #include <gtest/gtest.h>
 
@@ -151,7 +151,7 @@ TEST(SceneRefusal, HullFarFromTheBodyOriginLoads) {
   World w = buildWorld(s);
   // Density 1000 x (0.1 m)^3: 1 kg, to the round-off of coordinates near
   // 1e4 (ulp 2e-12, relative 2e-11 of the 0.1 m side, times 3 for a volume).
-  EXPECT_NEAR(w.body(BodyId{2}).mass, 1.0, 1e-9);
+  EXPECT_NEAR(w.mass(w.findBody("b")), 1.0, 1e-9);
 }
 
 // Deep nesting is refused while parsing: 100,000 levels once overflowed the

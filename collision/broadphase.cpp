@@ -26,7 +26,7 @@ void BroadPhase::markMoved(int h) {
   }
 }
 
-int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacement) {
+int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacement, int owner) {
   int h;
   if (free_ >= 0) {
     h = free_;
@@ -43,6 +43,7 @@ int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacemen
   p.moved = moved;
   p.alive = true;
   p.user = user;
+  p.owner = owner;
   if (tight.isInfinite()) {
     p.fat = tight;
     infinite_.insert(std::lower_bound(infinite_.begin(), infinite_.end(), h), h);
@@ -92,15 +93,20 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
 void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
   // 1. Pairs found by querying each moved proxy. A pair of two moved
   //    proxies is found twice; keep it from the lower handle's query.
+  //    A query stops at max_pairs_ other proxies (the bound in the header).
   fresh_.clear();
+  capped_.clear();
   for (int m : moved_) {
     const Proxy& pm = proxies_[m];
     if (!pm.alive) continue;
+    int found = 0;
     auto add = [&](int o) {
-      if (o == m) return;
       const Proxy& po = proxies_[o];
-      if (po.moved && o < m) return;
-      fresh_.emplace_back(std::min(m, o), std::max(m, o));
+      if (o == m || (pm.owner >= 0 && po.owner == pm.owner)) return true;
+      if (!(po.moved && o < m)) fresh_.emplace_back(std::min(m, o), std::max(m, o));
+      if (pm.leaf < 0 || po.leaf < 0 || ++found < max_pairs_) return true;
+      capped_.push_back(m);
+      return false;
     };
     if (pm.leaf < 0) {
       // Infinite: tested against every finite proxy (an axis-aligned
@@ -111,7 +117,7 @@ void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
         if (pm.fat.overlaps(proxies_[o].fat)) add(o);
       }
     } else {
-      tree_.query(pm.fat, [&](int leaf) { add(tree_.user(leaf)); return true; }, &overlap_tests_);
+      tree_.query(pm.fat, [&](int leaf) { return add(tree_.user(leaf)); }, &overlap_tests_);
       for (int i : infinite_) {
         ++overlap_tests_;
         if (pm.fat.overlaps(proxies_[i].fat)) add(i);

@@ -62,9 +62,18 @@ struct RunFigures {
   int contacts_max = 0, islands_max = 0, contacts_final = 0;
   Real penetration_last_second = 0;
   Real last_second_from = 0;  // time at which the last second of the run starts
+  // Energy through the run (StepStats::energy): its extremes over every
+  // step, and every energy_every-th step's value, at most 1,000 of them
+  // whatever the run's length.
+  int energy_every = 1;
+  Real energy_min = kInf, energy_max = -kInf;
+  std::vector<Real> energy;
 
   void record(const World& w) {
     const StepStats& st = w.lastStepStats();
+    energy_min = std::min(energy_min, st.energy);
+    energy_max = std::max(energy_max, st.energy);
+    if (w.stepCount() % energy_every == 0) energy.push_back(st.energy);
     contacts_max = std::max(contacts_max, st.contacts);
     contacts_final = st.contacts;
     islands_max = std::max(islands_max, st.islands);
@@ -101,6 +110,12 @@ struct RunFigures {
     m["contacts_final"] = contacts_final;
     m["islands_max"] = islands_max;
     m["penetration_last_second_max_m"] = figure(penetration_last_second);
+    m["energy_min"] = figure(w.stepCount() ? energy_min : 0.0);
+    m["energy_max"] = figure(w.stepCount() ? energy_max : 0.0);
+    m["energy_every"] = energy_every;
+    nlohmann::json series = nlohmann::json::array();
+    for (const Real e : energy) series.push_back(figure(e));
+    m["energy"] = series;
   }
 };
 
@@ -159,6 +174,7 @@ int runScene(const RunOptions& opt) {
   const Real e0 = world.kineticEnergy() + world.potentialEnergy();
   RunFigures fig;
   fig.last_second_from = scene.steps * scene.dt - 1;
+  fig.energy_every = static_cast<int>(std::max<long long>(1, (static_cast<long long>(scene.steps) + 999) / 1000));
   const auto t0 = std::chrono::steady_clock::now();
   int status = 0;
   for (int s = 1; s <= scene.steps; ++s) {
@@ -174,9 +190,17 @@ int runScene(const RunOptions& opt) {
     if (traj && s % opt.every == 0) writeRows(*traj, row, world, s);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  for (const Diagnostic& d : world.diagnostics())
+  // On stderr the first 20 (a pile of coincident bodies reports each one);
+  // the metrics hold them all.
+  const auto diagnostics = world.diagnostics();
+  for (size_t i = 0; i < std::min<size_t>(diagnostics.size(), 20); ++i) {
+    const Diagnostic& d = diagnostics[i];
     std::cerr << "cairn run: " << opt.scene << ": body '" << d.body_name << "': " << d.kind << " in " << d.count
               << " (sub)steps from step " << d.first_step + 1 << ": " << d.detail << "\n";
+  }
+  if (diagnostics.size() > 20)
+    std::cerr << "cairn run: " << opt.scene << ": " << diagnostics.size() - 20
+              << " more diagnostics (all in the metrics)\n";
   if (status != 0) return status;  // the output files are removed unwritten
 
   if (metrics) {

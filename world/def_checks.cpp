@@ -195,6 +195,10 @@ void checkSolverSettings(const SolverSettings& s, const InputLimits& limits) {
                              std::pair{s.sleep_time, "sleep_time"}})
     magnitude(o, f, v);
   magnitudeOrInfinity(o, "max_angular_velocity", s.max_angular_velocity);
+  for (const auto& [v, f] : {std::pair{s.energy_rise, "energy_rise"}, std::pair{s.joint_drift, "joint_drift"},
+                             std::pair{s.joint_drift_angle, "joint_drift_angle"},
+                             std::pair{s.penetration_drift, "penetration_drift"}})
+    magnitudeOrInfinity(o, f, v);
 }
 
 void checkScene(const SceneDesc& scene, const InputLimits& limits) {

@@ -441,6 +441,12 @@ SolverSettings parseSolver(const json& j) {
   s.sleep_angular_velocity = r.number("sleep_angular_velocity", s.sleep_angular_velocity);
   s.sleep_time = r.number("sleep_time", s.sleep_time);
   s.max_angular_velocity = r.number("max_angular_velocity", s.max_angular_velocity);
+  s.max_pairs_per_shape = r.intIn("max_pairs_per_shape", s.max_pairs_per_shape, 1);
+  s.max_exact_rows = r.intIn("max_exact_rows", s.max_exact_rows, 1);
+  s.energy_rise = r.number("energy_rise", s.energy_rise);
+  s.joint_drift = r.number("joint_drift", s.joint_drift);
+  s.joint_drift_angle = r.number("joint_drift_angle", s.joint_drift_angle);
+  s.penetration_drift = r.number("penetration_drift", s.penetration_drift);
   if (r.has("gyroscopic")) s.gyroscopic = parseGyro(r, r.string("gyroscopic"));
   if (r.has("orientation")) {
     const std::string o = r.string("orientation");

@@ -183,6 +183,35 @@ TEST(CliRun, MetricsHoldNoNull) {
   EXPECT_TRUE(m["energy_final"].is_number());
 }
 
+// Energy is recorded through the run, at most 1,000 samples whatever its
+// length. A 1 kg ball falling freely under symplectic Euler (v += h g, then
+// x += h v) loses exactly m g^2 h^2 / 2 per step:
+//   dE = m g h v1 - m g h (v1 + v0) / 2 = m g h (v1 - v0) / 2 = -m g^2 h^2 / 2,
+// so sample k (step k * every) is E0 - k every m g^2 h^2 / 2. The tolerance,
+// 1e-4 J, is a relative 1e-9 of the kinetic and potential energies, which
+// reach 7e4 J: round-off of 2,500 steps (about 1e-13 relative) with room.
+TEST(CliRun, EnergyIsRecordedThroughTheRun) {
+  const TempDir tmp("cairn_run_energy");
+  const std::string scene = write(tmp, "fall.json", R"({
+    "steps": 2500, "dt": 0.015625,
+    "bodies": [{"name": "ball", "mass": 1, "shapes": [{"type": "sphere", "radius": 0.5}]}]
+  })");
+  const CliResult r = runCairn("run " + scene + " --metrics " + (tmp / "m.json"), tmp);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");  // nothing to diagnose in a free fall
+  const auto m = nlohmann::json::parse(slurp(tmp / "m.json"));
+  const int every = m["energy_every"].get<int>();
+  EXPECT_EQ(every, 3);  // ceil(2500 / 1000)
+  ASSERT_EQ(m["energy"].size(), 833u);  // steps 3, 6, ..., 2499
+  const double e0 = m["energy_initial"].get<double>(), h = 0.015625, g = 9.81;
+  for (size_t k = 0; k < m["energy"].size(); ++k) {
+    const double want = e0 - double((k + 1) * every) * g * g * h * h / 2;
+    ASSERT_NEAR(m["energy"][k].get<double>(), want, 1e-9 * 1e5) << "sample " << k;
+  }
+  EXPECT_NEAR(m["energy_max"].get<double>(), e0 - g * g * h * h / 2, 1e-6);
+  EXPECT_NEAR(m["energy_min"].get<double>(), e0 - 2500 * g * g * h * h / 2, 1e-4);
+}
+
 // Peak resident memory of `cairn ARGS` run from the source directory (the
 // child's own high-water mark, from wait4).
 long peakKib(const std::string& args, int& status) {

@@ -121,12 +121,13 @@ class Reader {
       if (!v[k].is_number()) fail(key, "must be an array [w, x, y, z]" + got(v));
       c[k] = v[k].get<Real>();
     }
-    // The norm is taken of the scaled coefficients, so that a quaternion
-    // whose squared norm would overflow or underflow is still normalized
-    // exactly (Eigen's norm() squares first).
+    // A quaternion whose squared norm would overflow or underflow is scaled
+    // first (Eigen's norm() squares); one of ordinary size is normalized as
+    // written, so a unit quaternion reads back to the same bits.
     const Real big = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(c[2]), std::abs(c[3])});
     if (!(big > 0)) fail(key, "zero-length quaternion");
-    Quat q(c[0] / big, c[1] / big, c[2] / big, c[3] / big);
+    const Real scale = big > Real(1e-150) && big < Real(1e150) ? Real(1) : big;
+    Quat q(c[0] / scale, c[1] / scale, c[2] / scale, c[3] / scale);
     if (!q.coeffs().allFinite()) fail(key, "must be finite");
     return q.normalized();
   }

@@ -91,9 +91,11 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
 }
 
 void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
-  // 1. Pairs found by querying each moved proxy. A pair of two moved
-  //    proxies is found twice; keep it from the lower handle's query.
-  //    A query stops at max_pairs_ other proxies (the bound in the header).
+  // 1. Pairs found by querying each moved proxy. A query stops at
+  //    max_pairs_ other proxies (the bound in the header). A pair of two
+  //    moved proxies may be found twice (the sort below keeps one): keeping
+  //    it from one side only would lose it whenever that side's query was
+  //    the one cut short (a ground box under 900 new boxes).
   fresh_.clear();
   capped_.clear();
   for (int m : moved_) {
@@ -103,7 +105,7 @@ void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
     auto add = [&](int o) {
       const Proxy& po = proxies_[o];
       if (o == m || (pm.owner >= 0 && po.owner == pm.owner)) return true;
-      if (!(po.moved && o < m)) fresh_.emplace_back(std::min(m, o), std::max(m, o));
+      fresh_.emplace_back(std::min(m, o), std::max(m, o));
       if (pm.leaf < 0 || po.leaf < 0 || ++found < max_pairs_) return true;
       capped_.push_back(m);
       return false;

@@ -28,10 +28,14 @@
 // Bounded pairs: one proxy's query stops after max_pairs_per_proxy other
 // proxies (setMaxPairsPerProxy), so the pair list holds at most that many
 // pairs per finite proxy whatever the scene (N coincident boxes make
-// N max / 2 pairs, not N (N - 1) / 2). Each pair belongs to the query of
-// the proxy that moved last, and each query keeps at most the maximum, so
-// the bound holds across updates. Which overlaps a capped query keeps
-// follows the tree's order: deterministic. cappedProxies() names the
+// N max pairs at most, not N (N - 1) / 2). A pair stays in the list only
+// while neither proxy moves, so every listed pair was found by the latest
+// query of one of its proxies, and each query keeps at most the maximum:
+// the bound holds across updates. A pair is kept when either side's query
+// found it, so a large proxy whose own query was cut short (a ground box
+// under many bodies) still pairs with every small proxy that queried it.
+// Which overlaps a capped query keeps follows the tree's order:
+// deterministic. cappedProxies() names the
 // proxies whose query stopped early in the last update. Infinite proxies
 // (planes) are not capped: they are few, and a ground plane under 10,000
 // boxes must pair with all of them.

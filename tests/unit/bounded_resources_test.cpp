@@ -63,6 +63,22 @@ TEST(BoundedResources, CoincidentBodiesMakeLinearlyManyPairs) {
   EXPECT_EQ(all_diags, 0);
 }
 
+// A ground box under 900 boxes: its own query is cut short at 64, but each
+// box's query finds it, so every box rests on it: one manifold per box, and
+// all 900 asleep once still (each box its own island). Keeping a pair from
+// one side's query only once left 836 boxes without their ground.
+TEST(BoundedResources, AGroundBoxUnderManyBodiesPairsWithEveryOne) {
+  World w;
+  w.createBody(scenarios::ground());
+  for (int i = 0; i < 30; ++i)
+    for (int k = 0; k < 30; ++k)
+      w.createBody(test::boxDef("b" + std::to_string(i) + "_" + std::to_string(k), Vec3(1.5 * i, 0.5, 1.5 * k)));
+  for (int s = 0; s < 60; ++s) w.step(Real(1) / 60);
+  EXPECT_EQ(w.lastStepStats().contacts, 900);
+  EXPECT_EQ(w.lastStepStats().sleeping_bodies, 900);
+  EXPECT_EQ(diagnosticsOfKind(w, "contact pairs capped"), 0);
+}
+
 // The bound holds across incremental updates (pairs are kept between
 // updates and re-found only for proxies that moved): random boxes moving in
 // a small region, at most N * max pairs after every update, each pair a

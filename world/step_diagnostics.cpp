@@ -174,7 +174,7 @@ void watchPenetration(WorldImpl& w) {
     w.diagnose(dyn.index, "penetration",
                "penetrates '" + (other.isWorld() ? std::string("world") : w.body(other).name) + "' by " + fmt(depth) +
                    " m (slop " + fmt(s.slop) + " + penetration_drift " + fmt(s.penetration_drift) +
-                   " m): a stack sinking or a contact not resolved; more iterations or substeps", true);
+                   " m): a hard impact, a stack sinking or a contact not resolved; more iterations or substeps", true);
   }
 }
 

@@ -1,6 +1,7 @@
 // The `cairn` subcommands. Each returns the process exit status:
 //   0 success, 1 a check failed (validate), 2 bad input (nothing written),
-//   3 a non-finite state was caught during the run (run, bench).
+//   3 a non-finite state was caught during the run (run, bench); main() maps
+//   whatever escapes a command to these (docs/reliability.md).
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -1,25 +1,35 @@
 // `cairn run SCENE.json [--steps N] [--dt H] [--out traj.csv] [--every K]
 //  [--metrics m.json] [--method pgs|direct|lcp] [--substeps N]
-//  [--iterations N] [--save-state FILE]`: simulate a scene and write its
-// trajectory; `cairn run --restore FILE --steps N [...]` goes on from a
-// snapshot that --save-state wrote (docs/snapshots.md), bit-identically.
-// Trajectory rows are numbered by the world's step count, so a restored
-// run's rows continue the saved run's.
+//  [--iterations N] [--limit NAME=N ...] [--save-state FILE]`: simulate a
+// scene and write its trajectory; `cairn run --restore FILE --steps N [...]`
+// goes on from a snapshot that --save-state wrote (docs/snapshots.md),
+// bit-identically. Trajectory rows are numbered by the world's step count,
+// so a restored run's rows continue the saved run's.
+//
+// Everything that can be checked is checked before the first step: the
+// scene (with the input limits), the overrides, and the output paths (not
+// a directory, not the same file twice, not the scene itself, in a
+// directory that takes a new file: the output files are created there
+// before the run). The trajectory is streamed to its temporary file as the
+// run goes, so memory stays flat however long the run; both files replace
+// their targets only when the run succeeded (validation/output_file.hpp).
 #include "cli/commands.hpp"
 #include "cli/solver_overrides.hpp"
 #include "cairn/error.hpp"
+#include "validation/csv.hpp"
+#include "validation/output_file.hpp"
+#include "world/def_checks.hpp"
 #include "world/scene_json.hpp"
 #include "world/world_access.hpp"
 
 #include <nlohmann/json.hpp>
 
-#include <charconv>
 #include <chrono>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
+#include <cmath>
 #include <iostream>
+#include <memory>
 #include <optional>
+#include <sstream>
 
 namespace cairn::cli {
 
@@ -34,7 +44,16 @@ struct RunOptions {
   int every = 1;
   std::string metrics;
   SolverOverrides solver;
+  std::vector<std::string> limits;  // NAME=VALUE
 };
+
+// A figure for the metrics file: a JSON number when finite; JSON has no
+// spelling for infinity or NaN (nlohmann would write null), so those are
+// the strings "inf", "-inf" and "nan" (docs/reliability.md).
+nlohmann::json figure(double v) {
+  if (std::isfinite(v)) return v;
+  return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+}
 
 // Figures gathered over a run for the metrics file.
 struct RunFigures {
@@ -48,9 +67,18 @@ struct RunFigures {
   Real penetration_last_second = 0;
   Real last_second_from = 0;  // time at which the last second of the run starts
   double stage_seconds[kStageCount] = {};  // summed over the run
+  // Energy through the run (StepStats::energy): its extremes over every
+  // step, and every energy_every-th step's value, at most 1,000 of them
+  // whatever the run's length.
+  int energy_every = 1;
+  Real energy_min = kInf, energy_max = -kInf;
+  std::vector<Real> energy;
 
   void record(const World& w) {
     const StepStats& st = w.lastStepStats();
+    energy_min = std::min(energy_min, st.energy);
+    energy_max = std::max(energy_max, st.energy);
+    if (w.stepCount() % energy_every == 0) energy.push_back(st.energy);
     contacts_max = std::max(contacts_max, st.contacts);
     contacts_final = st.contacts;
     islands_max = std::max(islands_max, st.islands);
@@ -73,73 +101,56 @@ struct RunFigures {
     const int steps = std::max(1, w.stepCount());
     m["iterations_total"] = iterations;
     m["iterations_per_step"] = double(iterations) / steps;
-    m["residual_final"] = residual_final;
-    m["residual_max"] = residual_max;
+    m["residual_final"] = figure(residual_final);
+    m["residual_max"] = figure(residual_max);
     m["residual_definition"] = "max_i |lambda_i - clamp(lambda_i - w_i, lo_i, hi_i)|, w = J v - rhs + cfm lambda";
     m["rows_max"] = rows_max;
     nlohmann::json kinds = nlohmann::json::object();
     for (int k = 0; k < kRowKindCount; ++k) kinds[rowKindName(static_cast<RowKind>(k))] = rows_by_kind_max[k];
     m["rows_by_kind_max"] = kinds;
     m["joint_count"] = cairn::detail::internals(w).jointSlots();
-    m["joint_error_linear_max_m"] = joint_linear_max;
-    m["joint_error_angular_max_rad"] = joint_angular_max;
+    m["joint_error_linear_max_m"] = figure(joint_linear_max);
+    m["joint_error_angular_max_rad"] = figure(joint_angular_max);
     m["joints_broken"] = broken;
     m["contacts_max"] = contacts_max;
     m["contacts_final"] = contacts_final;
     m["islands_max"] = islands_max;
-    m["penetration_last_second_max_m"] = penetration_last_second;
+    m["penetration_last_second_max_m"] = figure(penetration_last_second);
     nlohmann::json stages = nlohmann::json::object();  // wall ms per step, by stage of the step
     for (int k = 0; k < kStageCount; ++k) stages[stageName(static_cast<Stage>(k))] = 1e3 * stage_seconds[k] / steps;
     m["stage_ms_per_step"] = stages;
+    m["energy_min"] = figure(w.stepCount() ? energy_min : 0.0);
+    m["energy_max"] = figure(w.stepCount() ? energy_max : 0.0);
+    m["energy_every"] = energy_every;
+    nlohmann::json series = nlohmann::json::array();
+    for (const Real e : energy) series.push_back(figure(e));
+    m["energy"] = series;
   }
 };
 
-// Shortest text that reads back to the same double (round-trip exact).
-void putNumber(std::string& line, double v) {
-  char buf[32];
-  auto res = std::to_chars(buf, buf + sizeof buf, v);
-  line.append(buf, res.ptr);
-}
-
-void appendRows(std::string& out, const World& w, int step) {
+// One row per non-static body: step, time, name, position, orientation,
+// linear and angular velocity.
+void writeRows(validation::OutputFile& out, validation::CsvRecord& row, const World& w, int step) {
   for (const Body& b : cairn::detail::internals(w).bodies()) {
     if (b.type == BodyType::Static) continue;
-    std::string line;
-    line += std::to_string(step);
-    line += ',';
-    putNumber(line, w.time());
-    line += ',';
-    line += b.name;
-    const double vals[13] = {b.position.x(), b.position.y(), b.position.z(), b.orientation.w(),
-                             b.orientation.x(), b.orientation.y(), b.orientation.z(),
-                             b.linear_velocity.x(), b.linear_velocity.y(), b.linear_velocity.z(),
-                             b.angular_velocity.x(), b.angular_velocity.y(), b.angular_velocity.z()};
-    for (double v : vals) {
-      line += ',';
-      putNumber(line, v);
-    }
-    line += '\n';
-    out += line;
+    row.clear();
+    row.integer(step).number(w.time()).text(b.name);
+    for (double v : {b.position.x(), b.position.y(), b.position.z(), b.orientation.w(), b.orientation.x(),
+                     b.orientation.y(), b.orientation.z(), b.linear_velocity.x(), b.linear_velocity.y(),
+                     b.linear_velocity.z(), b.angular_velocity.x(), b.angular_velocity.y(), b.angular_velocity.z()})
+      row.number(v);
+    out.write(row.line());
   }
-}
-
-// Writes to NAME.tmp and renames, so a failed run leaves no partial file.
-void writeAtomically(const std::string& path, const std::string& content) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) throw InputError(path, "", "cannot write output file");
-    f << content;
-    if (!f) throw InputError(path, "", "cannot write output file");
-  }
-  std::filesystem::rename(tmp, path);
 }
 
 int runScene(const RunOptions& opt) {
   SceneDesc scene;
+  std::unique_ptr<validation::OutputFile> traj, metrics;
   World world;
   const std::string& source = opt.restore.empty() ? opt.scene : opt.restore;
   try {
+    InputLimits limits;
+    for (const std::string& l : opt.limits) setInputLimit(limits, l);
     if (opt.scene.empty() == opt.restore.empty()) throw InputError("", "", "give a scene file or --restore FILE (one of them)");
     if (!opt.restore.empty()) {
       // The snapshot's world, its settings and its last step size.
@@ -149,34 +160,45 @@ int runScene(const RunOptions& opt) {
       scene.dt = cairn::detail::internals(world).stepContext().h;
       if (!(scene.dt > 0) && !opt.dt) throw InputError("--dt", "", "is required: the snapshot was taken before any step");
     } else {
-      scene = loadScene(opt.scene);
+      scene = loadScene(opt.scene, limits);
     }
     if (opt.steps) {
       if (*opt.steps < 0) throw InputError("--steps", "", "must be >= 0");
       scene.steps = *opt.steps;
     }
     if (opt.dt) {
-      if (!std::isfinite(*opt.dt) || *opt.dt <= 0) throw InputError("--dt", "", "must be positive and finite");
+      if (!(*opt.dt >= kMinSize && *opt.dt <= kMaxMagnitude)) {
+        std::ostringstream range;
+        range << "must lie in [" << kMinSize << ", " << kMaxMagnitude << "] s (docs/reliability.md)";
+        throw InputError("--dt", "", range.str());
+      }
       scene.dt = *opt.dt;
     }
     if (opt.every < 1) throw InputError("--every", "", "must be >= 1");
     applySolverOverrides(opt.solver, scene);
+    checkSolverSettings(scene.solver, limits);
+    validation::checkOutputPaths({{"--out", opt.out}, {"--metrics", opt.metrics}, {"--save-state", opt.save_state}},
+                                 {source});
     if (opt.restore.empty()) world = buildWorld(scene);
     else world.setSettings(scene.solver);
+    if (!opt.out.empty()) traj = std::make_unique<validation::OutputFile>(opt.out);
+    if (!opt.metrics.empty()) metrics = std::make_unique<validation::OutputFile>(opt.metrics);
   } catch (const InputError& e) {
     std::cerr << "cairn run: " << e.what() << "\n";
     return 2;
   }
 
-  std::string csv;
-  if (!opt.out.empty()) {
-    csv = "step,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
-    appendRows(csv, world, world.stepCount());
+  validation::CsvRecord row;
+  if (traj) {
+    traj->write(validation::csvRecord({"step", "time", "body", "px", "py", "pz", "qw", "qx", "qy", "qz", "vx", "vy",
+                                       "vz", "wx", "wy", "wz"}));
+    writeRows(*traj, row, world, world.stepCount());
   }
   const int first_step = world.stepCount();  // 0, or the snapshot's
   const Real e0 = world.kineticEnergy() + world.potentialEnergy();
   RunFigures fig;
   fig.last_second_from = world.time() + scene.steps * scene.dt - 1;
+  fig.energy_every = static_cast<int>(std::max<long long>(1, (static_cast<long long>(scene.steps) + 999) / 1000));
   const auto t0 = std::chrono::steady_clock::now();
   int status = 0;
   for (int s = 1; s <= scene.steps; ++s) {
@@ -189,45 +211,59 @@ int runScene(const RunOptions& opt) {
       status = 3;
       break;
     }
-    if (!opt.out.empty() && s % opt.every == 0) appendRows(csv, world, world.stepCount());
+    if (traj && s % opt.every == 0) writeRows(*traj, row, world, world.stepCount());
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  for (const Diagnostic& d : world.diagnostics())
+  // On stderr the first 20 (a pile of coincident bodies reports each one);
+  // the metrics hold them all.
+  const auto diagnostics = world.diagnostics();
+  for (size_t i = 0; i < std::min<size_t>(diagnostics.size(), 20); ++i) {
+    const Diagnostic& d = diagnostics[i];
     std::cerr << "cairn run: " << source << ": body '" << d.body_name << "': " << d.kind << " in " << d.count
               << " (sub)steps from step " << d.first_step + 1 << ": " << d.detail << "\n";
-  if (status != 0) return status;
-
-  try {
-    if (!opt.out.empty()) writeAtomically(opt.out, csv);
-    if (!opt.save_state.empty()) world.saveSnapshot(opt.save_state);
-    if (!opt.metrics.empty()) {
-      nlohmann::json m;
-      m["scene"] = source;
-      m["steps"] = world.stepCount();
-      m["dt"] = scene.dt;
-      m["method"] = solverMethodName(scene.solver.method);
-      m["substeps"] = scene.solver.substeps;
-      m["iterations"] = scene.solver.iterations;
-      m["body_count"] = world.bodyCount();
-      m["wall_time_s"] = wall;
-      m["wall_time_per_step_ms"] = world.stepCount() > first_step ? 1e3 * wall / (world.stepCount() - first_step) : 0.0;
-      m["energy_initial"] = e0;
-      nlohmann::json diags = nlohmann::json::array();
-      for (const Diagnostic& d : world.diagnostics())
-        diags.push_back({{"body", d.body_name}, {"kind", d.kind}, {"detail", d.detail}, {"first_step", d.first_step + 1},
-                         {"count", d.count}});
-      m["diagnostics"] = diags;
-      m["energy_final"] = world.kineticEnergy() + world.potentialEnergy();
-      fig.write(m, world);
-      writeAtomically(opt.metrics, m.dump(2) + "\n");
-    }
-  } catch (const InputError& e) {
-    std::cerr << "cairn run: " << e.what() << "\n";
-    return 2;
   }
+  if (diagnostics.size() > 20)
+    std::cerr << "cairn run: " << source << ": " << diagnostics.size() - 20
+              << " more diagnostics (all in the metrics)\n";
+  if (status != 0) return status;  // the output files are removed unwritten
+  if (!opt.save_state.empty()) {
+    try {
+      world.saveSnapshot(opt.save_state);
+    } catch (const InputError& e) {
+      std::cerr << "cairn run: " << e.what() << "\n";
+      return 2;
+    }
+  }
+
+  if (metrics) {
+    nlohmann::json m;
+    m["scene"] = source;
+    m["steps"] = world.stepCount();
+    m["dt"] = scene.dt;
+    m["method"] = solverMethodName(scene.solver.method);
+    m["substeps"] = scene.solver.substeps;
+    m["iterations"] = scene.solver.iterations;
+    m["body_count"] = world.bodyCount();
+    m["wall_time_s"] = wall;
+    m["wall_time_per_step_ms"] = world.stepCount() > first_step ? 1e3 * wall / (world.stepCount() - first_step) : 0.0;
+    m["energy_initial"] = figure(e0);
+    nlohmann::json diags = nlohmann::json::array();
+    for (const Diagnostic& d : world.diagnostics())
+      diags.push_back({{"body", d.body_name}, {"kind", d.kind}, {"detail", d.detail}, {"first_step", d.first_step + 1},
+                       {"count", d.count}});
+    m["diagnostics"] = diags;
+    m["energy_final"] = figure(world.kineticEnergy() + world.potentialEnergy());
+    fig.write(m, world);
+    // The scene path comes from the command line and may not be UTF-8.
+    metrics->write(m.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  }
+  // Both files are complete before either replaces its target.
+  if (traj) traj->finish();
+  if (metrics) metrics->finish();
+  if (traj) traj->commit();
+  if (metrics) metrics->commit();
   std::cout << source << ": " << world.stepCount() << " steps of " << scene.dt << " s, "
-            << world.bodyCount() << " bodies, " << 1e3 * wall / std::max(1, world.stepCount() - first_step)
-            << " ms/step\n";
+            << world.bodyCount() << " bodies, " << 1e3 * wall / std::max(1, world.stepCount() - first_step) << " ms/step\n";
   return 0;
 }
 
@@ -245,6 +281,8 @@ void addRunCommand(CLI::App& app, int& status) {
   run->add_option("--save-state", opt->save_state, "Snapshot of the world after the run to write");
   run->add_option("--restore", opt->restore, "Go on from this snapshot instead of a scene (needs --steps)");
   addSolverOverrideOptions(*run, opt->solver);
+  run->add_option("--limit", opt->limits,
+                  "Raise or lower an input limit, NAME=N (repeatable; docs/reliability.md lists them)");
   run->callback([opt, &status] { status = runScene(*opt); });
 }
 

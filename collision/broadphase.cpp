@@ -26,7 +26,7 @@ void BroadPhase::markMoved(int h) {
   }
 }
 
-int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacement) {
+int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacement, int owner) {
   int h;
   if (free_ >= 0) {
     h = free_;
@@ -43,6 +43,7 @@ int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacemen
   p.moved = moved;
   p.alive = true;
   p.user = user;
+  p.owner = owner;
   if (tight.isInfinite()) {
     p.fat = tight;
     infinite_.insert(std::lower_bound(infinite_.begin(), infinite_.end(), h), h);
@@ -99,7 +100,7 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
 std::vector<BroadPhase::ProxyState> BroadPhase::proxyStates() const {
   std::vector<ProxyState> out;
   out.reserve(proxies_.size());
-  for (const Proxy& p : proxies_) out.push_back({p.fat, p.user, p.next_free, p.alive});
+  for (const Proxy& p : proxies_) out.push_back({p.fat, p.user, p.owner, p.next_free, p.alive});
   return out;
 }
 
@@ -111,6 +112,7 @@ void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) 
     Proxy& p = proxies_[i];
     p.fat = proxies[i].fat;
     p.user = proxies[i].user;
+    p.owner = proxies[i].owner;
     p.next_free = proxies[i].next_free;
     p.alive = proxies[i].alive;
     if (!p.alive) continue;
@@ -123,17 +125,24 @@ void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) 
 }
 
 void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
-  // 1. Pairs found by querying each moved proxy. A pair of two moved
-  //    proxies is found twice; keep it from the lower handle's query.
+  // 1. Pairs found by querying each moved proxy. A query stops at
+  //    max_pairs_ other proxies (the bound in the header). A pair of two
+  //    moved proxies may be found twice (the sort below keeps one): keeping
+  //    it from one side only would lose it whenever that side's query was
+  //    the one cut short (a ground box under 900 new boxes).
   fresh_.clear();
+  capped_.clear();
   for (int m : moved_) {
     const Proxy& pm = proxies_[m];
     if (!pm.alive) continue;
+    int found = 0;
     auto add = [&](int o) {
-      if (o == m) return;
       const Proxy& po = proxies_[o];
-      if (po.moved && o < m) return;
+      if (o == m || (pm.owner >= 0 && po.owner == pm.owner)) return true;
       fresh_.emplace_back(std::min(m, o), std::max(m, o));
+      if (pm.leaf < 0 || po.leaf < 0 || ++found < max_pairs_) return true;
+      capped_.push_back(m);
+      return false;
     };
     if (pm.leaf < 0) {
       // Infinite: tested against every finite proxy (an axis-aligned
@@ -144,7 +153,7 @@ void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
         if (pm.fat.overlaps(proxies_[o].fat)) add(o);
       }
     } else {
-      tree_.query(pm.fat, [&](int leaf) { add(tree_.user(leaf)); return true; }, &overlap_tests_);
+      tree_.query(pm.fat, [&](int leaf) { return add(tree_.user(leaf)); }, &overlap_tests_);
       for (int i : infinite_) {
         ++overlap_tests_;
         if (pm.fat.overlaps(proxies_[i].fat)) add(i);

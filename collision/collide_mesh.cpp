@@ -15,6 +15,7 @@
 #include "collision/aabb.hpp"
 #include "collision/mesh_bvh.hpp"
 #include "collision/narrowphase.hpp"
+#include "collision/triangle_area.hpp"
 
 #include <algorithm>
 
@@ -36,9 +37,7 @@ int meshConvex(const ShapeDesc& mesh, const Transform& tm, const ShapeDesc& b, c
   for (const int t : candidates) {
     const auto& tri = md.triangles[t];
     const Vec3 w0 = tm.apply(md.vertices[tri[0]]), w1 = tm.apply(md.vertices[tri[1]]), w2 = tm.apply(md.vertices[tri[2]]);
-    const Vec3 e = (w1 - w0).cross(w2 - w0);
-    const Real size2 = std::max({(w1 - w0).squaredNorm(), (w2 - w0).squaredNorm(), (w2 - w1).squaredNorm()});
-    if (!(e.norm() > Real(1e-12) * size2)) continue;  // no area, no normal
+    if (!triangleHasArea(w0, w1, w2)) continue;  // no area, no normal (a mesh built in code may have them)
     Manifold m;
     if (!convexProxies(makeTriangleProxy(w0, w1, w2), pb, margin, m)) continue;
     m.triangle = t;

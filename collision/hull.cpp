@@ -116,7 +116,10 @@ class QhullRun {
 }  // namespace
 
 std::shared_ptr<const ConvexHullData> buildConvexHull(const std::vector<Vec3>& points, const std::string& object,
-                                                      const std::string& field) {
+                                                      const std::string& field, const InputLimits& limits) {
+  if (points.size() > limits.hull_points)
+    throw InputError(object, field, std::to_string(points.size()) + " points exceed the limit " +
+                                        limitHint("hull_points", limits.hull_points));
   for (size_t i = 0; i < points.size(); ++i)
     if (!points[i].allFinite())
       throw InputError(object, field, "points[" + std::to_string(i) + "] is not finite");

@@ -11,14 +11,29 @@
 // Records that carry no geometry for collision (vn, vt, vp, o, g, s, usemtl,
 // mtllib, l, p, comments) are skipped. Anything else is an error: a typo in
 // level geometry is better reported than silently dropped.
+//
+// Triangles without area (repeated corners, collinear corners, slivers: see
+// collision/triangle_area.hpp) are dropped. They cover no surface, so no
+// contact is lost: in a mesh that is closed or tiles a surface, their edges
+// are edges of the neighbouring triangles. Exporters write them routinely
+// (a polygon with collinear corners, fanned), so refusing them would refuse
+// ordinary level geometry. A mesh with no triangle left has nothing a body
+// can rest on (bodies would fall through it) and is refused.
+//
+// Counts are checked against InputLimits before each allocation, and a
+// coordinate beyond kMaxMagnitude is refused like a non-finite one
+// (include/cairn/limits.hpp).
 #include "collision/obj_mesh.hpp"
 
 #include "collision/mesh_bvh.hpp"
+#include "collision/triangle_area.hpp"
 #include "cairn/error.hpp"
 
 #include <cerrno>
 #include <cstdlib>
+#include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -52,6 +67,12 @@ bool parseInt(const std::string& tok, long& out) {
   return errno == 0 && end == tok.c_str() + tok.size();
 }
 
+std::string magnitudeText() {
+  std::ostringstream s;
+  s << kMaxMagnitude;
+  return s.str();
+}
+
 bool ignoredRecord(const std::string& k) {
   static const char* kIgnored[] = {"vn", "vt", "vp", "o", "g", "s", "usemtl", "mtllib", "l", "p"};
   for (const char* s : kIgnored)
@@ -62,10 +83,23 @@ bool ignoredRecord(const std::string& k) {
 }  // namespace
 
 std::shared_ptr<const TriangleMeshData> loadObjMesh(const std::string& path, const std::string& object,
-                                                    const std::string& field) {
-  std::ifstream in(path);
+                                                    const std::string& field, const InputLimits& limits) {
+  // Only a regular file: a directory, a FIFO or a device (/dev/zero) would
+  // fail late or never end.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(object, field, path + ":0: cannot open file (not a regular file, or missing)");
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > limits.file_bytes)
+    throw InputError(object, field, path + ":0: " + std::to_string(bytes) + " bytes exceed the limit " +
+                                        limitHint("file_bytes", limits.file_bytes));
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(object, field, path + ":0: cannot open file (" + std::strerror(errno) + ")");
+  return parseObjMesh(in, path, object, field, limits);
+}
 
+std::shared_ptr<const TriangleMeshData> parseObjMesh(std::istream& in, const std::string& path, const std::string& object,
+                                                     const std::string& field, const InputLimits& limits) {
   auto mesh = std::make_shared<TriangleMeshData>();
   Reader r{path, object, field};
   // Positive indices are resolved after the whole file is read (some
@@ -97,7 +131,11 @@ std::shared_ptr<const TriangleMeshData> loadObjMesh(const std::string& path, con
         Real ignored;
         if (extra >= 4 || !parseReal(tok, ignored)) r.fail("malformed vertex: expected 'v x y z [w] [r g b]'");
       }
-      if (!v.allFinite()) r.fail("vertex is not finite");
+      if (!v.allFinite() || v.cwiseAbs().maxCoeff() > kMaxMagnitude)
+        r.fail("vertex is not finite or has a coordinate of magnitude above " + magnitudeText());
+      if (mesh->vertices.size() >= limits.mesh_vertices)
+        r.fail("more than " + std::to_string(limits.mesh_vertices) + " vertices " +
+               limitHint("mesh_vertices", limits.mesh_vertices));
       mesh->vertices.push_back(v);
     } else if (key == "f") {
       corners.clear();
@@ -120,6 +158,9 @@ std::shared_ptr<const TriangleMeshData> loadObjMesh(const std::string& path, con
         corners.push_back(idx);
       }
       if (corners.size() < 3) r.fail("face needs at least 3 vertices");
+      if (pending.size() + (corners.size() - 2) > limits.mesh_triangles)
+        r.fail("more than " + std::to_string(limits.mesh_triangles) + " triangles " +
+               limitHint("mesh_triangles", limits.mesh_triangles));
       for (size_t j = 1; j + 1 < corners.size(); ++j)
         pending.push_back({{corners[0], corners[j], corners[j + 1]}, r.line});
     } else if (!ignoredRecord(key)) {
@@ -129,6 +170,7 @@ std::shared_ptr<const TriangleMeshData> loadObjMesh(const std::string& path, con
   if (in.bad()) r.fail("read error");
 
   const long nv = static_cast<long>(mesh->vertices.size());
+  mesh->triangles.reserve(pending.size());
   for (const Pending& p : pending) {
     for (long idx : p.index) {
       if (idx >= nv) {
@@ -136,12 +178,16 @@ std::shared_ptr<const TriangleMeshData> loadObjMesh(const std::string& path, con
         r.fail("face index " + std::to_string(idx + 1) + " out of range (" + std::to_string(nv) + " vertices)");
       }
     }
-    // A triangle that repeats a vertex has no area and no normal: skip it.
-    if (p.index[0] == p.index[1] || p.index[1] == p.index[2] || p.index[0] == p.index[2]) continue;
+    const auto& v = mesh->vertices;
+    if (!triangleHasArea(v[p.index[0]], v[p.index[1]], v[p.index[2]])) continue;  // see the top of the file
     mesh->triangles.push_back({static_cast<int>(p.index[0]), static_cast<int>(p.index[1]), static_cast<int>(p.index[2])});
   }
+  if (pending.empty())
+    throw InputError(object, field, path + ":" + std::to_string(r.line) + ": no triangles (no 'f' records)");
   if (mesh->triangles.empty())
-    throw InputError(object, field, path + ":" + std::to_string(r.line) + ": no triangles (no 'f' records with 3 distinct vertices)");
+    throw InputError(object, field, path + ":" + std::to_string(r.line) + ": no triangle with an area (" +
+                                        std::to_string(pending.size()) +
+                                        " faces' triangles, all with repeated or collinear corners): bodies would fall through");
   buildMeshBvh(*mesh);
   return mesh;
 }

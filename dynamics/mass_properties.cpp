@@ -18,23 +18,36 @@ const char* shapeTypeName(ShapeType t) {
 namespace {
 
 // Mass properties of a closed polyhedron by summing signed tetrahedra
-// (origin, a, b, c) over a fan triangulation of each face. The second
-// moment of a tetrahedron with edge matrix A = [a b c] is
-// det(A) A C0 A^T with C0 = [[2,1,1],[1,2,1],[1,1,2]] / 120 (canonical
-// tetrahedron), and I = tr(C) E - C.
+// (o, a, b, c) over a fan triangulation of each face. The second moment of
+// a tetrahedron with edge matrix A = [a-o b-o c-o] is det(A) A C0 A^T with
+// C0 = [[2,1,1],[1,2,1],[1,1,2]] / 120 (canonical tetrahedron), and
+// I = tr(C) E - C.
+//
+// The apex o is the mean of the hull's vertices, not the shape's origin: the
+// sums are then of vectors as long as the hull is wide, and the second
+// moment about the center of mass, C - m c c^T, is a difference of terms of
+// the hull's own size. About a far origin (a hull 10 km from its body's
+// origin) C and m c c^T would each be ~|c|^2 / width^2 times larger than
+// their difference, and that many digits of it would be lost (1e-16 x
+// (1e4 / 0.1)^2 = 1e-6 relative for a 0.1 m hull at 10 km, much more
+// further out), down to a tensor that is no longer positive definite.
 MassProperties hullMassProperties(const ConvexHullData& hull, Real density) {
+  if (hull.vertices.empty()) return {};
   Mat3 c0;
   c0 << 2, 1, 1, 1, 2, 1, 1, 1, 2;
   c0 /= Real(120);
+  Vec3 o = Vec3::Zero();
+  for (const Vec3& v : hull.vertices) o += v;
+  o /= Real(hull.vertices.size());
   Real volume = 0;
   Vec3 first_moment = Vec3::Zero();
   Mat3 second_moment = Mat3::Zero();
   for (const auto& face : hull.faces) {
     for (size_t i = 1; i + 1 < face.size(); ++i) {
       Mat3 a;
-      a.col(0) = hull.vertices[face[0]];
-      a.col(1) = hull.vertices[face[i]];
-      a.col(2) = hull.vertices[face[i + 1]];
+      a.col(0) = hull.vertices[face[0]] - o;
+      a.col(1) = hull.vertices[face[i]] - o;
+      a.col(2) = hull.vertices[face[i + 1]] - o;
       const Real det = a.determinant();
       volume += det / Real(6);
       first_moment += det / Real(24) * (a.col(0) + a.col(1) + a.col(2));
@@ -44,8 +57,9 @@ MassProperties hullMassProperties(const ConvexHullData& hull, Real density) {
   MassProperties mp;
   if (volume <= 0) return mp;
   mp.mass = density * volume;
-  mp.center = first_moment / volume;
-  const Mat3 c_com = density * second_moment - mp.mass * mp.center * mp.center.transpose();
+  const Vec3 center_from_o = first_moment / volume;
+  mp.center = o + center_from_o;
+  const Mat3 c_com = density * second_moment - mp.mass * center_from_o * center_from_o.transpose();
   mp.inertia = c_com.trace() * Mat3::Identity() - c_com;
   return mp;
 }

@@ -1,5 +1,7 @@
 #include "validation/report.hpp"
 
+#include "validation/csv.hpp"
+
 #include "cairn/error.hpp"
 #include "validation/plot_script.hpp"
 #include "validation/replay_page.hpp"
@@ -35,10 +37,12 @@ std::string num(double v, int digits = 6) {
   return fmt(digits == 4 ? "%.2e" : "%.4e", v);
 }
 
-// Shortest text that reads back to the same double, for the CSVs.
+// Shortest text that reads back to the same double, for the CSVs; a
+// missing sample (non-finite) is an empty cell.
 std::string exact(double v) {
-  if (!std::isfinite(v)) return "";
-  return fmt("%.10g", v);
+  std::string s;
+  if (std::isfinite(v)) appendExactNumber(s, v);
+  return s;
 }
 
 void writeFile(const fs::path& path, const std::string& content) {
@@ -243,20 +247,18 @@ std::string sceneCsv(const SceneResult& r, const std::string& stem, Json& plots,
                               {{"cairn_penetration", "cairn"}, {"bullet_penetration", "Bullet"}}));
     pngs.push_back(stem + "_penetration.png");
   }
-  std::string out;
-  for (size_t i = 0; i < header.size(); ++i) out += (i ? "," : "") + header[i];
-  out += "\n";
+  std::string out = csvRecord(header);
+  CsvRecord rec;
   const int n = std::max(c.samples(), b.samples());
   for (int s = 0; s < n; ++s) {
     const std::vector<double>& times = s < c.samples() ? c.time : b.time;
-    out += exact(times[size_t(s)]);
+    rec.clear();
+    rec.text(exact(times[size_t(s)]));
     for (const auto& [cv, bv] : cols) {
-      out += ",";
-      if (cv && s < int(cv->size())) out += exact((*cv)[size_t(s)]);
-      out += ",";
-      if (bv && s < int(bv->size())) out += exact((*bv)[size_t(s)]);
+      rec.text(cv && s < int(cv->size()) ? exact((*cv)[size_t(s)]) : "");
+      rec.text(bv && s < int(bv->size()) ? exact((*bv)[size_t(s)]) : "");
     }
-    out += "\n";
+    out += rec.line();
   }
   return out;
 }

@@ -1,5 +1,7 @@
 #include "validation/solver_keys.hpp"
 
+#include "validation/csv.hpp"
+
 #include "cairn/error.hpp"
 #include "world/world_access.hpp"
 
@@ -78,9 +80,9 @@ double parseNumberText(const std::string& option, const std::string& text) {
 }
 
 std::string exactNumberText(double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
+  std::string s;
+  appendExactNumber(s, v);
+  return s;
 }
 
 void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& value, const std::string& option) {

@@ -54,10 +54,11 @@ std::optional<double> figureValue(const std::vector<Figure>& figs, const std::st
   return f ? f->cairn : std::nullopt;
 }
 
-// One line of text for a CSV cell: no commas, quotes or line breaks.
+// One line of text for a table cell (the Markdown table has one row per
+// line; the CSV writer quotes whatever else the text holds).
 std::string cell(std::string s) {
   for (char& c : s)
-    if (c == ',' || c == '"' || c == '\n' || c == '\r') c = c == ',' ? ';' : ' ';
+    if (c == '\n' || c == '\r') c = ' ';
   return s;
 }
 

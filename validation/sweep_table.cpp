@@ -1,6 +1,7 @@
 #include "validation/sweep_table.hpp"
 
 #include "cairn/error.hpp"
+#include "validation/csv.hpp"
 #include "validation/solver_keys.hpp"
 
 #include <algorithm>
@@ -18,17 +19,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 namespace {
-
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out;
-  size_t from = 0;
-  while (true) {
-    const size_t at = line.find(sep, from);
-    out.push_back(line.substr(from, at == std::string::npos ? std::string::npos : at - from));
-    if (at == std::string::npos) return out;
-    from = at + 1;
-  }
-}
 
 std::vector<std::string> csvHeader(const SweepTable& t) {
   std::vector<std::string> h{"index"};
@@ -125,15 +115,15 @@ void markPareto(std::vector<SweepRow>& rows, Measure axis) {
 }
 
 std::string sweepCsv(const SweepTable& t) {
-  std::string out;
-  const auto header = csvHeader(t);
-  for (size_t i = 0; i < header.size(); ++i) out += (i ? "," : "") + header[i];
-  out += "\n";
+  std::string out = csvRecord(csvHeader(t));
+  CsvRecord rec;
   for (const SweepRow& r : t.rows) {
-    out += std::to_string(r.index);
-    for (const std::string& s : r.settings) out += "," + s;
-    for (const auto& v : r.values) out += "," + (v ? exactNumberText(*v) : std::string());
-    out += std::string(",") + (r.pareto ? "1" : "0") + "," + r.status + "," + r.notes + "\n";
+    rec.clear();
+    rec.integer(r.index);
+    for (const std::string& s : r.settings) rec.text(s);
+    for (const auto& v : r.values) v ? rec.number(*v) : rec.text("");
+    rec.text(r.pareto ? "1" : "0").text(r.status).text(r.notes);
+    out += rec.line();
   }
   return out;
 }
@@ -216,15 +206,15 @@ SweepTable readSweepPart(const std::string& dir) {
   for (const auto& c : t.manifest["columns"]) t.setting_columns.push_back(c.get<std::string>());
 
   const fs::path csv_path = root / "sweep.csv";
-  std::istringstream csv(readText(csv_path));
-  std::string line;
-  std::getline(csv, line);
+  const auto records = parseCsv(readText(csv_path), csv_path.string());
   const auto header = csvHeader(t);
-  if (split(line, ',') != header) throw InputError(csv_path.string(), "", "header does not match sweep.json's columns");
-  for (int n = 2; std::getline(csv, line); ++n) {
-    if (line.empty()) continue;
-    const auto cells = split(line, ',');
-    const auto bad = [&](const std::string& why) { return InputError(csv_path.string() + ":" + std::to_string(n), "", why); };
+  if (records.empty() || records.front() != header)
+    throw InputError(csv_path.string(), "", "header does not match sweep.json's columns");
+  for (size_t n = 1; n < records.size(); ++n) {
+    const auto& cells = records[n];
+    const auto bad = [&](const std::string& why) {
+      return InputError(csv_path.string() + ": record " + std::to_string(n + 1), "", why);
+    };
     if (cells.size() != header.size())
       throw bad("has " + std::to_string(cells.size()) + " cells, the header " + std::to_string(header.size()));
     SweepRow r;

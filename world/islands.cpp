@@ -115,6 +115,33 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
     ctx.body_island[static_cast<size_t>(i)] = isl;
   }
   ctx.island_method.assign(static_cast<size_t>(ctx.island_count), w.settings_.method);
+  if (w.settings_.method == SolverMethod::LCP) limitExactIslands(w, ctx);
+}
+
+// The exact LCP is dense: its memory grows with the square of an island's
+// rows and its time with the cube (pyramid-10 in one island took 30 s a
+// step). An island whose rows, estimated before any is built, exceed
+// max_exact_rows is solved by PGS this step; step_diagnostics.cpp reports it.
+void limitExactIslands(WorldImpl& w, StepContext& ctx) {
+  std::vector<std::int64_t>& rows = ctx.island_rows_estimate;
+  rows.assign(static_cast<size_t>(ctx.island_count), 0);
+  const auto island = [&](BodyId a, BodyId b) {
+    for (const BodyId id : {a, b})
+      if (!id.isWorld() && ctx.body_island[static_cast<size_t>(id.index)] >= 0)
+        return ctx.body_island[static_cast<size_t>(id.index)];
+    return -1;
+  };
+  for (const Contact& c : w.contacts_) {
+    const std::int32_t isl = c.enabled ? island(c.body_a, c.body_b) : -1;
+    if (isl >= 0)
+      rows[static_cast<size_t>(isl)] += 3 * c.count + (c.rolling_friction > 0 || c.torsional_friction > 0 ? 3 : 0);
+  }
+  for (const Joint& j : w.joints_) {
+    const std::int32_t isl = j.alive && !j.broken ? island(j.def.body_a, j.def.body_b) : -1;
+    if (isl >= 0) rows[static_cast<size_t>(isl)] += 6;
+  }
+  for (size_t isl = 0; isl < rows.size(); ++isl)
+    if (rows[isl] > w.settings_.max_exact_rows) ctx.island_method[isl] = SolverMethod::PGS;
 }
 
 void updateSleep(WorldImpl& w, StepContext& ctx) {

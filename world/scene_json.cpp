@@ -1,14 +1,19 @@
 #include "world/scene_json.hpp"
 
+#include "world/def_checks.hpp"
+
 #include "collision/hull.hpp"
 #include "collision/obj_mesh.hpp"
 #include "cairn/error.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
 namespace cairn {
@@ -17,8 +22,16 @@ using nlohmann::json;
 
 namespace {
 
+bool isPrintableName(const std::string& s) {
+  return std::none_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+}
+
 // Reads one JSON object, remembering which keys were used so that unknown
 // keys (a typo such as "masss") are reported instead of silently ignored.
+// Every read checks the key's presence and JSON type and, for integers,
+// that the value fits the field (never wrapped): a bad file ends in an
+// InputError naming the object, the field and what is allowed, never in a
+// nlohmann exception.
 class Reader {
  public:
   Reader(const json& j, std::string object, std::string prefix = "")
@@ -30,73 +43,103 @@ class Reader {
     used_.insert(key);
     return j_.contains(key);
   }
-  const json& raw(const char* key) const {
-    used_.insert(key);
-    return j_.at(key);
+  // The value of a required key; `expected` says what it must be.
+  const json& required(const char* key, const std::string& expected) const {
+    if (!has(key)) fail(key, "missing: " + expected);
+    return j_.find(key).value();
   }
   std::string field(const std::string& key) const { return prefix_ + key; }
 
-  Real number(const char* key) const {
-    const json& v = raw(key);
-    if (!v.is_number()) fail(key, "must be a number");
-    return v.get<Real>();
-  }
+  Real number(const char* key) const { return numberOf(required(key, "a number"), key); }
   Real number(const char* key, Real def) const { return has(key) ? number(key) : def; }
   std::optional<Real> optNumber(const char* key) const {
     if (!has(key)) return std::nullopt;
     return number(key);
   }
-  int integer(const char* key, int def) const {
-    if (!has(key)) return def;
-    const json& v = raw(key);
-    if (!v.is_number_integer()) fail(key, "must be an integer");
-    return v.get<int>();
+  Real numberOf(const json& v, const std::string& key) const {
+    if (!v.is_number()) fail(key, "must be a number" + got(v));
+    return v.get<Real>();
+  }
+  // A non-negative integer in [lo, hi]: larger values are refused, never
+  // wrapped into the field's type.
+  std::uint64_t integer(const char* key, std::uint64_t lo, std::uint64_t hi) const {
+    const json& v = required(key, "an integer");
+    if (!v.is_number_unsigned() || v.get<std::uint64_t>() < lo || v.get<std::uint64_t>() > hi)
+      fail(key, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]" + got(v));
+    return v.get<std::uint64_t>();
+  }
+  int intIn(const char* key, int def, int lo) const {
+    return has(key) ? static_cast<int>(integer(key, static_cast<std::uint64_t>(lo), std::numeric_limits<int>::max())) : def;
+  }
+  std::uint32_t u32(const char* key, std::uint32_t def) const {
+    return has(key) ? static_cast<std::uint32_t>(integer(key, 0, std::numeric_limits<std::uint32_t>::max())) : def;
+  }
+  std::uint64_t u64(const char* key, std::uint64_t def) const {
+    return has(key) ? integer(key, 0, std::numeric_limits<std::uint64_t>::max()) : def;
   }
   bool boolean(const char* key, bool def) const {
     if (!has(key)) return def;
-    const json& v = raw(key);
-    if (!v.is_boolean()) fail(key, "must be true or false");
+    const json& v = required(key, "true or false");
+    if (!v.is_boolean()) fail(key, "must be true or false" + got(v));
     return v.get<bool>();
   }
   std::string string(const char* key) const {
-    const json& v = raw(key);
-    if (!v.is_string()) fail(key, "must be a string");
+    const json& v = required(key, "a string");
+    if (!v.is_string()) fail(key, "must be a string" + got(v));
     return v.get<std::string>();
   }
   std::string string(const char* key, const std::string& def) const { return has(key) ? string(key) : def; }
-  Vec3 vec3(const char* key) const { return vec3Of(raw(key), key); }
+  // A name: a string without control characters (it appears in messages,
+  // CSV rows and metrics as it is).
+  std::string name(const char* key) const {
+    std::string s = string(key);
+    if (!isPrintableName(s)) fail(key, "must be a name without control characters (U+0000 to U+001F, U+007F)");
+    return s;
+  }
+  std::string name(const char* key, const std::string& def) const { return has(key) ? name(key) : def; }
+  const json& array(const char* key, const std::string& expected) const {
+    const json& v = required(key, expected);
+    if (!v.is_array()) fail(key, "must be " + expected + got(v));
+    return v;
+  }
+  Vec3 vec3(const char* key) const { return vec3Of(required(key, "an array of 3 numbers"), key); }
   Vec3 vec3(const char* key, const Vec3& def) const { return has(key) ? vec3(key) : def; }
   Vec3 vec3Of(const json& v, const std::string& key) const {
-    if (!v.is_array() || v.size() != 3) fail(key, "must be an array of 3 numbers");
+    if (!v.is_array() || v.size() != 3) fail(key, "must be an array of 3 numbers" + got(v));
     Vec3 r;
     for (int k = 0; k < 3; ++k) {
-      if (!v[k].is_number()) fail(key, "must be an array of 3 numbers");
+      if (!v[k].is_number()) fail(key, "must be an array of 3 numbers" + got(v));
       r[k] = v[k].get<Real>();
     }
     return r;
   }
   Quat quat(const char* key) const {
-    const json& v = raw(key);
-    if (!v.is_array() || v.size() != 4) fail(key, "must be an array [w, x, y, z]");
+    const json& v = required(key, "an array [w, x, y, z]");
+    if (!v.is_array() || v.size() != 4) fail(key, "must be an array [w, x, y, z]" + got(v));
     Real c[4];
     for (int k = 0; k < 4; ++k) {
-      if (!v[k].is_number()) fail(key, "must be an array [w, x, y, z]");
+      if (!v[k].is_number()) fail(key, "must be an array [w, x, y, z]" + got(v));
       c[k] = v[k].get<Real>();
     }
-    Quat q(c[0], c[1], c[2], c[3]);
+    // A quaternion whose squared norm would overflow or underflow is scaled
+    // first (Eigen's norm() squares); one of ordinary size is normalized as
+    // written, so a unit quaternion reads back to the same bits.
+    const Real big = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(c[2]), std::abs(c[3])});
+    if (!(big > 0)) fail(key, "zero-length quaternion");
+    const Real scale = big > Real(1e-150) && big < Real(1e150) ? Real(1) : big;
+    Quat q(c[0] / scale, c[1] / scale, c[2] / scale, c[3] / scale);
     if (!q.coeffs().allFinite()) fail(key, "must be finite");
-    if (q.norm() < Real(1e-9)) fail(key, "zero-length quaternion");
     return q.normalized();
   }
   Quat quat(const char* key, const Quat& def) const { return has(key) ? quat(key) : def; }
   Mat3 mat3(const char* key) const {
-    const json& v = raw(key);
+    const json& v = required(key, "a 3x3 array of numbers");
     Mat3 m;
-    if (!v.is_array() || v.size() != 3) fail(key, "must be a 3x3 array of numbers");
+    if (!v.is_array() || v.size() != 3) fail(key, "must be a 3x3 array of numbers" + got(v));
     for (int r = 0; r < 3; ++r) {
-      if (!v[r].is_array() || v[r].size() != 3) fail(key, "must be a 3x3 array of numbers");
+      if (!v[r].is_array() || v[r].size() != 3) fail(key, "must be a 3x3 array of numbers" + got(v));
       for (int c = 0; c < 3; ++c) {
-        if (!v[r][c].is_number()) fail(key, "must be a 3x3 array of numbers");
+        if (!v[r][c].is_number()) fail(key, "must be a 3x3 array of numbers" + got(v));
         m(r, c) = v[r][c].get<Real>();
       }
     }
@@ -116,15 +159,53 @@ class Reader {
   const std::string& object() const { return object_; }
 
  private:
+  // " (got VALUE)": what was found, shortened (it may be anything).
+  static std::string got(const json& v) {
+    if (v.is_array()) return " (got an array of " + std::to_string(v.size()) + ")";
+    if (v.is_object()) return " (got an object)";
+    std::string t = v.dump(-1, ' ', false, json::error_handler_t::replace);
+    if (t.size() > 40) t = t.substr(0, 37) + "...";
+    return " (got " + t + ")";
+  }
+
   const json& j_;
   std::string object_, prefix_;
   mutable std::set<std::string> used_;
 };
 
-ShapeDesc parseShape(const json& j, const std::string& object, const std::string& prefix,
-                     const std::filesystem::path& base_dir) {
+// "body 'crate'" when the entry has a usable name, else "body #3".
+std::string objectLabel(const char* kind, const json& j, size_t index) {
+  if (j.is_object()) {
+    const auto it = j.find("name");
+    if (it != j.end() && it->is_string() && isPrintableName(it->get<std::string>()))
+      return std::string(kind) + " '" + it->get<std::string>() + "'";
+  }
+  return std::string(kind) + " #" + std::to_string(index);
+}
+
+// What every part of a scene is read with: where relative mesh paths start
+// and the input limits.
+struct Context {
+  std::filesystem::path base_dir;
+  const InputLimits& limits;
+};
+
+// Refuses an array longer than `limit` before anything is built from it.
+void checkCount(const Reader& r, const char* key, const json& array, std::uint64_t limit, const char* name) {
+  if (array.size() > limit) r.fail(key, std::to_string(array.size()) + " entries exceed the limit " + limitHint(name, limit));
+}
+
+// The direction of v, normalized without squaring huge or tiny components
+// into infinity or zero (Eigen's normalized() squares first); v unchanged
+// when it has no direction.
+Vec3 direction(const Vec3& v) {
+  if (!v.allFinite()) return v;
+  const Real big = v.cwiseAbs().maxCoeff();
+  return big > 0 ? Vec3(v / big).normalized() : v;
+}
+
+ShapeDesc parseShape(const json& j, const std::string& object, const std::string& prefix, const Context& ctx) {
   Reader r(j, object, prefix);
-  if (!r.has("type")) r.fail("type", "missing shape type");
   const std::string type = r.string("type");
   ShapeDesc s;
   if (type == "sphere") {
@@ -139,22 +220,22 @@ ShapeDesc parseShape(const json& j, const std::string& object, const std::string
     s.half_height = r.number("half_height");
   } else if (type == "plane") {
     s.type = ShapeType::Plane;
-    s.normal = r.vec3("normal");
-    if (s.normal.allFinite() && s.normal.norm() > 0) s.normal.normalize();
+    s.normal = direction(r.vec3("normal"));
     s.offset = r.number("offset", 0);
   } else if (type == "convex_hull") {
     s.type = ShapeType::ConvexHull;
-    const json& pts = r.raw("points");
-    if (!pts.is_array()) r.fail("points", "must be an array of [x, y, z] points");
+    const json& pts = r.array("points", "an array of [x, y, z] points");
+    checkCount(r, "points", pts, ctx.limits.hull_points, "hull_points");
     std::vector<Vec3> points;
+    points.reserve(pts.size());
     for (size_t i = 0; i < pts.size(); ++i) points.push_back(r.vec3Of(pts[i], "points[" + std::to_string(i) + "]"));
-    s.hull = buildConvexHull(points, object, r.field("points"));
+    s.hull = buildConvexHull(points, object, r.field("points"), ctx.limits);
   } else if (type == "mesh") {
     s.type = ShapeType::Mesh;
     const std::string rel = r.string("obj");
-    const std::filesystem::path p = std::filesystem::path(rel).is_absolute() ? std::filesystem::path(rel) : base_dir / rel;
+    const std::filesystem::path p = std::filesystem::path(rel).is_absolute() ? std::filesystem::path(rel) : ctx.base_dir / rel;
     s.source = p.string();
-    s.mesh = loadObjMesh(p.string(), object, r.field("obj"));
+    s.mesh = loadObjMesh(p.string(), object, r.field("obj"), ctx.limits);
   } else {
     r.fail("type", "unknown shape type '" + type + "' (sphere, box, capsule, cylinder, plane, convex_hull, mesh)");
   }
@@ -168,19 +249,16 @@ ShapeDesc parseShape(const json& j, const std::string& object, const std::string
 std::vector<Vec3> vec3List(const Reader& r, const char* key) {
   std::vector<Vec3> out;
   if (!r.has(key)) return out;
-  const json& v = r.raw(key);
-  if (!v.is_array()) r.fail(key, "must be an array of [x, y, z] axes");
+  const json& v = r.array(key, "an array of [x, y, z] axes");
   for (size_t i = 0; i < v.size(); ++i) out.push_back(r.vec3Of(v[i], std::string(key) + "[" + std::to_string(i) + "]"));
   return out;
 }
 
-BodyDef parseBody(const json& j, size_t index, const std::filesystem::path& base_dir) {
-  std::string object = "body #" + std::to_string(index);
-  if (j.is_object() && j.contains("name") && j["name"].is_string()) object = "body '" + j["name"].get<std::string>() + "'";
-  Reader r(j, object);
+BodyDef parseBody(const json& j, size_t index, const Context& ctx) {
+  Reader r(j, objectLabel("body", j, index));
+  const std::string& object = r.object();
   BodyDef b;
-  if (!r.has("name")) r.fail("name", "missing body name");
-  b.name = r.string("name");
+  b.name = r.name("name");
   if (b.name.empty() || b.name == "world") r.fail("name", "must be a non-empty name other than 'world'");
   const std::string type = r.string("type", "dynamic");
   if (type == "dynamic") b.type = BodyType::Dynamic;
@@ -201,19 +279,19 @@ BodyDef parseBody(const json& j, size_t index, const std::filesystem::path& base
   b.linear_damping = r.number("linear_damping", 0);
   b.angular_damping = r.number("angular_damping", 0);
   b.ccd = r.boolean("ccd", false);
-  if (r.has("collision_group")) b.collision_group = static_cast<std::uint32_t>(r.integer("collision_group", 1));
-  if (r.has("collision_mask")) b.collision_mask = static_cast<std::uint32_t>(r.raw("collision_mask").get<std::int64_t>());
+  b.collision_group = r.u32("collision_group", b.collision_group);
+  b.collision_mask = r.u32("collision_mask", b.collision_mask);
   if (r.has("shapes")) {
-    const json& shapes = r.raw("shapes");
-    if (!shapes.is_array()) r.fail("shapes", "must be an array");
+    const json& shapes = r.array("shapes", "an array of shapes");
+    checkCount(r, "shapes", shapes, ctx.limits.shapes_per_body, "shapes_per_body");
+    b.shapes.reserve(shapes.size());
     for (size_t i = 0; i < shapes.size(); ++i)
-      b.shapes.push_back(parseShape(shapes[i], object, "shapes[" + std::to_string(i) + "].", base_dir));
+      b.shapes.push_back(parseShape(shapes[i], object, "shapes[" + std::to_string(i) + "].", ctx));
   }
   b.force = r.vec3("force", Vec3::Zero());
   b.torque = r.vec3("torque", Vec3::Zero());
   if (r.has("impulses")) {
-    const json& imps = r.raw("impulses");
-    if (!imps.is_array()) r.fail("impulses", "must be an array of {time, impulse, point}");
+    const json& imps = r.array("impulses", "an array of {time, impulse, point}");
     for (size_t i = 0; i < imps.size(); ++i) {
       Reader ir(imps[i], object, "impulses[" + std::to_string(i) + "].");
       BodyDef::TimedImpulse imp;
@@ -232,20 +310,32 @@ BodyDef parseBody(const json& j, size_t index, const std::filesystem::path& base
   return b;
 }
 
-BodyId bodyRef(const Reader& r, const SceneDesc& scene, const json& v, const std::string& field) {
+// Body names to indices, so that each reference of a joint or spring is
+// found in constant time (a linear search per reference is quadratic in a
+// large scene). The first of two bodies with the same name wins here; the
+// World refuses the second.
+using BodyNames = std::unordered_map<std::string, int>;
+
+BodyNames bodyNames(const SceneDesc& scene) {
+  BodyNames names;
+  names.reserve(scene.bodies.size());
+  for (size_t i = 0; i < scene.bodies.size(); ++i) names.emplace(scene.bodies[i].name, static_cast<int>(i));
+  return names;
+}
+
+BodyId bodyRef(const Reader& r, const BodyNames& names, const json& v, const std::string& field) {
   if (!v.is_string()) r.fail(field, "must be a body name or \"world\"");
   const std::string name = v.get<std::string>();
   if (name == "world") return kWorldBody;
-  const int idx = scene.bodyIndex(name);
-  if (idx < 0) r.fail(field, "no body named '" + name + "'");
-  return BodyId{idx};
+  const auto it = names.find(name);
+  if (it == names.end()) r.fail(field, "no body named '" + name + "'");
+  return BodyId{it->second};
 }
 
-std::pair<BodyId, BodyId> bodyPair(const Reader& r, const SceneDesc& scene) {
-  if (!r.has("bodies")) r.fail("bodies", "missing: give [a, b] with body names or \"world\"");
-  const json& v = r.raw("bodies");
+std::pair<BodyId, BodyId> bodyPair(const Reader& r, const BodyNames& names) {
+  const json& v = r.required("bodies", "[a, b] with body names or \"world\"");
   if (!v.is_array() || v.size() != 2) r.fail("bodies", "must be [a, b] with body names or \"world\"");
-  return {bodyRef(r, scene, v[0], "bodies[0]"), bodyRef(r, scene, v[1], "bodies[1]")};
+  return {bodyRef(r, names, v[0], "bodies[0]"), bodyRef(r, names, v[1], "bodies[1]")};
 }
 
 Softness parseSoftness(const Reader& r) {
@@ -321,18 +411,15 @@ JointType jointType(const Reader& r, const std::string& t) {
                      "' (ball, hinge, slider, fixed, universal, cone_twist, distance, angular_motor, six_dof)");
 }
 
-JointDef parseJoint(const json& j, size_t index, const SceneDesc& scene) {
-  std::string object = "joint #" + std::to_string(index);
-  if (j.is_object() && j.contains("name") && j["name"].is_string()) object = "joint '" + j["name"].get<std::string>() + "'";
-  Reader r(j, object);
+JointDef parseJoint(const json& j, size_t index, const BodyNames& names) {
+  Reader r(j, objectLabel("joint", j, index));
+  const std::string& object = r.object();
   JointDef d;
-  d.name = r.string("name", "joint" + std::to_string(index));
-  if (!r.has("type")) r.fail("type", "missing joint type");
+  d.name = r.name("name", "joint" + std::to_string(index));
   d.type = jointType(r, r.string("type"));
-  std::tie(d.body_a, d.body_b) = bodyPair(r, scene);
+  std::tie(d.body_a, d.body_b) = bodyPair(r, names);
   if (d.type == JointType::Distance) {
-    if (!r.has("anchors")) r.fail("anchors", "a distance joint needs two world points");
-    const json& a = r.raw("anchors");
+    const json& a = r.required("anchors", "a distance joint needs two world points [[x,y,z],[x,y,z]]");
     if (!a.is_array() || a.size() != 2) r.fail("anchors", "must be two world points [[x,y,z],[x,y,z]]");
     d.anchor_a = r.vec3Of(a[0], "anchors[0]");
     d.anchor_b = r.vec3Of(a[1], "anchors[1]");
@@ -342,11 +429,11 @@ JointDef parseJoint(const json& j, size_t index, const SceneDesc& scene) {
   }
   d.axis = r.vec3("axis", d.axis);
   d.axis2 = r.vec3("axis2", d.axis2);
-  if (r.has("limits")) d.limit = parseLimit(r.raw("limits"), object, "limits.");
+  if (r.has("limits")) d.limit = parseLimit(r.required("limits", "an object"), object, "limits.");
   if (r.has("swing_span1")) d.swing_span1 = r.number("swing_span1");
   if (r.has("swing_span2")) d.swing_span2 = r.number("swing_span2");
   if (r.has("motor")) {
-    const json& mj = r.raw("motor");
+    const json& mj = r.required("motor", "an object");
     if (d.type == JointType::AngularMotor) {
       if (!mj.is_array()) r.fail("motor", "an angular motor takes an array of {axis, target_velocity, max_force}");
       for (size_t i = 0; i < mj.size(); ++i) {
@@ -395,15 +482,15 @@ SolverSettings parseSolver(const json& j) {
   Reader r(j, "solver");
   SolverSettings s;
   if (r.has("method")) s.method = parseMethod(r, r.string("method"));
-  s.iterations = r.integer("iterations", s.iterations);
+  s.iterations = r.intIn("iterations", s.iterations, 1);
   s.tolerance = r.number("tolerance", s.tolerance);
   s.sor = r.number("sor", s.sor);
   s.warm_start = r.boolean("warm_start", s.warm_start);
   s.warm_start_factor = r.number("warm_start_factor", s.warm_start_factor);
   s.randomize_order = r.boolean("randomize_order", s.randomize_order);
   s.nncg = r.boolean("nncg", s.nncg);
-  if (r.has("seed")) s.seed = r.raw("seed").get<std::uint64_t>();
-  s.substeps = r.integer("substeps", s.substeps);
+  s.seed = r.u64("seed", s.seed);
+  s.substeps = r.intIn("substeps", s.substeps, 1);
   s.erp = r.number("erp", s.erp);
   s.cfm = r.number("cfm", s.cfm);
   s.contact_erp = r.number("contact_erp", s.contact_erp);
@@ -424,6 +511,12 @@ SolverSettings parseSolver(const json& j) {
   s.sleep_angular_velocity = r.number("sleep_angular_velocity", s.sleep_angular_velocity);
   s.sleep_time = r.number("sleep_time", s.sleep_time);
   s.max_angular_velocity = r.number("max_angular_velocity", s.max_angular_velocity);
+  s.max_pairs_per_shape = r.intIn("max_pairs_per_shape", s.max_pairs_per_shape, 1);
+  s.max_exact_rows = r.intIn("max_exact_rows", s.max_exact_rows, 1);
+  s.energy_rise = r.number("energy_rise", s.energy_rise);
+  s.joint_drift = r.number("joint_drift", s.joint_drift);
+  s.joint_drift_angle = r.number("joint_drift_angle", s.joint_drift_angle);
+  s.penetration_drift = r.number("penetration_drift", s.penetration_drift);
   if (r.has("gyroscopic")) s.gyroscopic = parseGyro(r, r.string("gyroscopic"));
   if (r.has("orientation")) {
     const std::string o = r.string("orientation");
@@ -448,47 +541,67 @@ std::string lineOf(const std::string& text, size_t byte) {
   return "line " + std::to_string(line) + ", column " + std::to_string(col);
 }
 
+// Parses JSON text with its nesting depth limited while parsing, so that
+// nothing after (copying, dumping, destroying the value, all recursive in
+// nlohmann::json) can exhaust the stack, and a number too large for a
+// double (1e999, JSON's only spelling of infinity) refused with its line.
+json parseJson(const std::string& text, const InputLimits& limits) {
+  if (text.size() > limits.file_bytes)
+    throw InputError("", "", std::to_string(text.size()) + " bytes exceed the limit " + limitHint("file_bytes", limits.file_bytes));
+  struct TooDeep {};
+  const json::parser_callback_t depth_check = [&](int depth, json::parse_event_t event, json&) {
+    // `depth` counts the containers already open around this one.
+    if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+        static_cast<std::uint64_t>(depth) >= limits.json_depth)
+      throw TooDeep{};
+    return true;
+  };
+  try {
+    return json::parse(text, depth_check);
+  } catch (const TooDeep&) {
+    throw InputError("", "", "arrays and objects nested more than " + std::to_string(limits.json_depth) + " deep " +
+                                 limitHint("json_depth", limits.json_depth));
+  } catch (const json::parse_error& e) {
+    throw InputError("", "", "malformed JSON at " + lineOf(text, e.byte == 0 ? 0 : e.byte - 1) + ": " + e.what());
+  } catch (const json::exception& e) {
+    // Number overflow (e.g. 1e999): locate the quoted token for the line.
+    const std::string what = e.what();
+    const auto q1 = what.find('\''), q2 = what.rfind('\'');
+    const auto at = q1 != std::string::npos && q2 > q1 ? text.find(what.substr(q1 + 1, q2 - q1 - 1)) : std::string::npos;
+    throw InputError("", "", "malformed JSON" + (at == std::string::npos ? std::string() : " at " + lineOf(text, at)) +
+                                 ": " + what + " (numbers must be finite)");
+  }
+}
+
 }  // namespace
 
-SceneDesc parseScene(const std::string& text, const std::string& path) {
+SceneDesc parseScene(const std::string& text, const std::string& path, const InputLimits& limits) {
   try {
-    json j;
-    try {
-      j = json::parse(text);
-    } catch (const json::parse_error& e) {
-      throw InputError("", "", "malformed JSON at " + lineOf(text, e.byte == 0 ? 0 : e.byte - 1) + ": " + e.what());
-    } catch (const json::exception& e) {
-      // Number overflow (e.g. 1e999, JSON's only way to spell a non-finite
-      // value): locate the quoted token for the line number.
-      const std::string what = e.what();
-      const auto q1 = what.find('\''), q2 = what.rfind('\'');
-      const auto at = q1 != std::string::npos && q2 > q1 ? text.find(what.substr(q1 + 1, q2 - q1 - 1)) : std::string::npos;
-      throw InputError("", "", "malformed JSON" + (at == std::string::npos ? std::string() : " at " + lineOf(text, at)) +
-                                   ": " + what + " (numbers must be finite)");
-    }
-    const std::filesystem::path base_dir = std::filesystem::path(path).parent_path();
+    const json j = parseJson(text, limits);
+    const Context ctx{std::filesystem::path(path).parent_path(), limits};
     Reader r(j, "scene");
     SceneDesc scene;
     scene.path = path;
     scene.gravity = r.vec3("gravity", scene.gravity);
     scene.dt = r.number("dt", scene.dt);
-    scene.steps = r.integer("steps", scene.steps);
-    if (r.has("solver")) scene.solver = parseSolver(r.raw("solver"));
+    scene.steps = r.intIn("steps", scene.steps, 0);
+    if (r.has("solver")) scene.solver = parseSolver(r.required("solver", "an object"));
     if (r.has("bodies")) {
-      const json& bodies = r.raw("bodies");
-      if (!bodies.is_array()) r.fail("bodies", "must be an array");
-      for (size_t i = 0; i < bodies.size(); ++i) scene.bodies.push_back(parseBody(bodies[i], i, base_dir));
+      const json& bodies = r.array("bodies", "an array of bodies");
+      checkCount(r, "bodies", bodies, limits.bodies, "bodies");
+      scene.bodies.reserve(bodies.size());
+      for (size_t i = 0; i < bodies.size(); ++i) scene.bodies.push_back(parseBody(bodies[i], i, ctx));
     }
+    const BodyNames names = bodyNames(scene);
     if (r.has("springs")) {
-      const json& springs = r.raw("springs");
-      if (!springs.is_array()) r.fail("springs", "must be an array");
+      const json& springs = r.array("springs", "an array of springs");
+      checkCount(r, "springs", springs, limits.springs, "springs");
       for (size_t i = 0; i < springs.size(); ++i) {
-        Reader s(springs[i], "spring #" + std::to_string(i));
+        Reader s(springs[i], objectLabel("spring", springs[i], i));
         SpringDef d;
-        d.name = s.string("name", "spring" + std::to_string(i));
-        std::tie(d.body_a, d.body_b) = bodyPair(s, scene);
-        if (!s.has("anchors")) s.fail("anchors", "missing: two world points");
-        const json& a = s.raw("anchors");
+        d.name = s.name("name", "spring" + std::to_string(i));
+        std::tie(d.body_a, d.body_b) = bodyPair(s, names);
+        const json& a = s.required("anchors", "two world points [[x,y,z],[x,y,z]]");
         if (!a.is_array() || a.size() != 2) s.fail("anchors", "must be two world points [[x,y,z],[x,y,z]]");
         d.anchor_a = s.vec3Of(a[0], "anchors[0]");
         d.anchor_b = s.vec3Of(a[1], "anchors[1]");
@@ -500,13 +613,14 @@ SceneDesc parseScene(const std::string& text, const std::string& path) {
       }
     }
     if (r.has("joints")) {
-      const json& joints = r.raw("joints");
-      if (!joints.is_array()) r.fail("joints", "must be an array");
-      for (size_t i = 0; i < joints.size(); ++i) scene.joints.push_back(parseJoint(joints[i], i, scene));
+      const json& joints = r.array("joints", "an array of joints");
+      checkCount(r, "joints", joints, limits.joints, "joints");
+      for (size_t i = 0; i < joints.size(); ++i) scene.joints.push_back(parseJoint(joints[i], i, names));
     }
-    if (r.has("validation")) scene.validation_json = r.raw("validation").dump();
-    if (r.has("description")) (void)r.raw("description");
+    if (r.has("validation")) scene.validation_json = r.required("validation", "an object").dump();
+    (void)r.string("description", "");
     r.finish();
+    checkScene(scene, limits);
     validateScene(scene);
     return scene;
   } catch (const InputError& e) {
@@ -515,12 +629,19 @@ SceneDesc parseScene(const std::string& text, const std::string& path) {
   }
 }
 
-SceneDesc loadScene(const std::string& path) {
-  std::ifstream in(path);
+SceneDesc loadScene(const std::string& path, const InputLimits& limits) {
+  // Only a regular file: a directory, a FIFO or a device (/dev/zero) would
+  // fail late or never end.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "", "not a regular file (or cannot be read)");
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > limits.file_bytes)
+    throw InputError(path, "", std::to_string(bytes) + " bytes exceed the limit " + limitHint("file_bytes", limits.file_bytes));
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open scene file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parseScene(ss.str(), path);
+  return parseScene(ss.str(), path, limits);
 }
 
 }  // namespace cairn

@@ -161,6 +161,8 @@ void checkBroadPhaseState(const WorldImpl& w, const std::vector<BroadPhase::Prox
     c.require(p.user >= 0 && static_cast<size_t>(p.user) < w.shapes_.size() && w.shapes_[static_cast<size_t>(p.user)].alive &&
                   w.shapes_[static_cast<size_t>(p.user)].proxy == h,
               "broadphase", "a proxy does not belong to a live shape");
+    c.require(p.owner == w.shapes_[static_cast<size_t>(p.user)].body.index, "broadphase",
+              "a proxy's owner is not its shape's body");
     const bool infinite = p.fat.isInfinite();
     c.require(!std::isnan(p.fat.lo.sum()) && !std::isnan(p.fat.hi.sum()) && (infinite || (p.fat.lo.array() <= p.fat.hi.array()).all()),
               "broadphase", "a proxy's box is not a box");

@@ -469,6 +469,7 @@ template <class Ar>
 void io(Ar& ar, BroadPhase::ProxyState& p) {
   io(ar, p.fat);
   ar(p.user);
+  ar(p.owner);
   ar(p.next_free);
   ar(p.alive);
 }

@@ -166,13 +166,19 @@ std::string solveCulprit(const WorldImpl& w, const StepContext& ctx, std::int32_
 
 }  // namespace
 
-void WorldImpl::diagnose(size_t body, const char* kind, const std::string& detail) {
-  for (Diagnostic& d : diagnostics_)
-    if (d.body.index == static_cast<std::int32_t>(body) && d.kind == kind) {
-      ++d.count;
-      return;
-    }
-  diagnostics_.push_back({bodyId(static_cast<int>(body)), bodies_[body].name, kind, detail, step_count_, 1});
+void WorldImpl::diagnose(std::int32_t body, const char* kind, const std::string& detail, bool once_per_step) {
+  for (size_t i = 0; i < diagnostics_.size(); ++i) {
+    Diagnostic& d = diagnostics_[i];
+    if (d.body.index != body || d.kind != kind) continue;
+    if (once_per_step && diagnostic_last_step_[i] == step_count_) return;
+    ++d.count;
+    diagnostic_last_step_[i] = step_count_;
+    d.detail = detail;  // the latest figures
+    return;
+  }
+  diagnostic_last_step_.push_back(step_count_);
+  if (body < 0) diagnostics_.push_back({kWorldBody, "world", kind, detail, step_count_, 1});
+  else diagnostics_.push_back({bodyId(body), bodies_[static_cast<size_t>(body)].name, kind, detail, step_count_, 1});
 }
 
 void saveStepStart(WorldImpl& w, StepContext& ctx) {

@@ -57,7 +57,7 @@ void integrateVelocities(WorldImpl& w, StepContext& ctx) {
     bool gyro_ok = true;
     ctx.orientation_offset[i] = integrateVelocity(b, w.gravity_, h, w.settings_.gyroscopic, &gyro_ok);
     if (!gyro_ok)
-      w.diagnose(i, "gyroscopic solve",
+      w.diagnose(static_cast<std::int32_t>(i), "gyroscopic solve",
                  "implicit-midpoint gyroscopic step not solved to 1e-10 |L| (h |w| = " +
                      std::to_string(h * b.angular_velocity.norm()) +
                      " rad): energy and |L| not conserved; substeps with h |w| < 1 restore it");

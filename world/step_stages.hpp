@@ -36,6 +36,11 @@ void applyRestitution(WorldImpl& w, StepContext& ctx);
 void emitContactEvents(WorldImpl& w, StepContext& ctx);
 // Sleeping bookkeeping (world/islands.cpp).
 void updateSleep(WorldImpl& w, StepContext& ctx);
+// Islands with method lcp over max_exact_rows go to PGS (world/islands.cpp).
+void limitExactIslands(WorldImpl& w, StepContext& ctx);
+// The watchers: energy rise, joint drift, penetration, tunnelling, limits
+// reached, into World::diagnostics (world/step_diagnostics.cpp).
+void watchStep(WorldImpl& w, StepContext& ctx);
 
 // The non-finite guard (world/step_guard.cpp).
 void saveStepStart(WorldImpl& w, StepContext& ctx);

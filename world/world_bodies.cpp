@@ -127,6 +127,14 @@ void validateSettings(const SolverSettings& s) {
   requireNonNegative(o, "sleep_linear_velocity", s.sleep_linear_velocity);
   requireNonNegative(o, "sleep_angular_velocity", s.sleep_angular_velocity);
   requireNonNegative(o, "sleep_time", s.sleep_time);
+  if (s.max_pairs_per_shape < 1)
+    throw InputError(o, "max_pairs_per_shape", "must be >= 1 (got " + std::to_string(s.max_pairs_per_shape) + ")");
+  if (s.max_exact_rows < 1)
+    throw InputError(o, "max_exact_rows", "must be >= 1 (got " + std::to_string(s.max_exact_rows) + ")");
+  for (const auto& [v, f] : {std::pair{s.energy_rise, "energy_rise"}, std::pair{s.joint_drift, "joint_drift"},
+                             std::pair{s.joint_drift_angle, "joint_drift_angle"},
+                             std::pair{s.penetration_drift, "penetration_drift"}})
+    if (!(v > 0)) throw InputError(o, f, "must be positive (infinity: never reported; got " + num(v) + ")");
 }
 
 namespace detail {
@@ -549,14 +557,17 @@ void WorldImpl::check(ShapeId id) const {
 // Pushing a body wakes it (and its island).
 void WorldImpl::applyForce(BodyId id, const Vec3& force, const Vec3& world_point) {
   wakeBody(id);
+  external_forces_ = true;  // work from outside: the energy watcher holds off
   applyForceAtPoint(body(id), force, world_point);
 }
 void WorldImpl::applyCentralForce(BodyId id, const Vec3& force) {
   wakeBody(id);
+  external_forces_ = true;  // work from outside: the energy watcher holds off
   body(id).force += force;
 }
 void WorldImpl::applyTorque(BodyId id, const Vec3& torque) {
   wakeBody(id);
+  external_forces_ = true;  // work from outside: the energy watcher holds off
   body(id).torque += torque;
 }
 void WorldImpl::applyImpulse(BodyId id, const Vec3& impulse, const Vec3& world_point) {

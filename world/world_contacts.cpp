@@ -45,7 +45,7 @@ void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
   const ShapeDesc& shape = b.shapes[static_cast<size_t>(index_in_body)];
   Aabb box = shapeAabb(shape, b.transform() * shape.local);
   if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
-  ref.proxy = broadphase_.createProxy(box, slot);
+  ref.proxy = broadphase_.createProxy(box, slot, Vec3::Zero(), id.index);  // a body's own shapes never pair
   b.shape_ids[static_cast<size_t>(index_in_body)] = slot;
 }
 
@@ -107,6 +107,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
   const auto body = [&](BodyId id) -> const Body& { return w.body(id); };
   // 1. Broadphase: move the proxies of bodies that can move.
   w.moveProxies(kWorldBody, h);
+  broadphase_.setMaxPairsPerProxy(settings_.max_pairs_per_shape);
   broadphase_.updatePairs(w.pairs_);
 
   // 2. Narrowphase over the candidate pairs, matching last step's contacts.

@@ -124,6 +124,8 @@ struct StepContext {
   // Scratch.
   std::vector<std::int32_t> island_start, island_fill, island_root, wake_list, sleep_first;
   std::vector<Real> island_min;
+  // Per island: its rows as estimated for the exact LCP's limit (world/islands.cpp).
+  std::vector<std::int64_t> island_rows_estimate;
 };
 
 class WorldImpl {
@@ -276,9 +278,15 @@ class WorldImpl {
   StepStats stats_;
   std::vector<NumericalEvent> numerical_events_;
   std::vector<Diagnostic> diagnostics_;
+  std::vector<int> diagnostic_last_step_;  // per diagnostic: the last step it was counted in
   std::vector<JointBreakEvent> break_events_;
 
-  void diagnose(size_t body, const char* kind, const std::string& detail);
+  // Records a diagnostic on a body (index; -1: the world as a whole),
+  // counted once per call, or once per step.
+  void diagnose(std::int32_t body, const char* kind, const std::string& detail, bool once_per_step = false);
+  // The step's watchers (world/step_diagnostics.cpp).
+  Real energy_rise_ = 0;          // energy gained since the low point of the current stretch without external work
+  bool external_forces_ = false;  // a force or torque applied through the API for the coming step
   void registerShape(BodyId id, std::int32_t index_in_body);
   void recomputeMass(Body& b, const std::string& object);
   void dropContactsOf(BodyId body, std::int32_t shape);  // shape -1: every shape of the body

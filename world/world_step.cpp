@@ -114,6 +114,7 @@ void WorldImpl::step(Real h) {
   clock.lap(Stage::Events);
   updateSleep(*this, ctx);
   clock.lap(Stage::Sleep);
+  watchStep(*this, ctx);  // diagnostics: what went wrong without a NaN
   moveProxies(kWorldBody, h);  // fat boxes hold the shapes where they ended, for queries between steps
   for (Body& b : bodies_) {
     b.force.setZero();

@@ -178,4 +178,4 @@ struct JointDef {
   bool collide_connected = false;
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

@@ -47,4 +47,4 @@ class NumericalError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

@@ -99,4 +99,4 @@ struct Diagnostic {
   int count = 0;  ///< how many (sub)steps it happened in
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

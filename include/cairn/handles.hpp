@@ -40,4 +40,4 @@ struct ShapeId {
   friend bool operator==(ShapeId a, ShapeId b) { return a.index == b.index && a.generation == b.generation; }  ///< same slot and generation
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

@@ -76,4 +76,4 @@ struct Transform {
   }
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

@@ -49,4 +49,4 @@ struct QueryFilter {
   std::function<bool(BodyId, ShapeId)> accept;
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

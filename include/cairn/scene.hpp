@@ -36,4 +36,4 @@ struct SceneDesc {
 /// throws InputError and builds nothing.
 World buildWorld(const SceneDesc& scene);
 
-}  ///< namespace cairn
+}  // namespace cairn

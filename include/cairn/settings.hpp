@@ -97,9 +97,40 @@ struct SolverSettings {
   /// Safety nets for the extremes.
   Real max_angular_velocity = kInf;  ///< rad/s, per body
 
+  // Bounds on what one step may cost (docs/reliability.md, "Bounded
+  // resources"). Each is checked before the step allocates for it; going
+  // past one is reported in World::diagnostics, never a std::bad_alloc.
+  //  max_pairs_per_shape  other shapes one shape's broadphase query pairs
+  //                       with: contacts grow linearly, not quadratically,
+  //                       with coincident bodies (1,000 boxes at one spot
+  //                       once made 499,500 contacts and 2.6 GB)
+  //  max_exact_rows       constraint rows of an island solved by the exact
+  //                       LCP (dense, cubic in its rows), estimated before
+  //                       the rows are built as 3 per contact point, 3 more
+  //                       per rolling contact and 6 per joint; a larger
+  //                       island is solved by PGS for that step
+  int max_pairs_per_shape = 64;
+  int max_exact_rows = 300;
+
+  // Watchers (world/step_diagnostics.cpp): what goes wrong silently,
+  // reported in World::diagnostics.
+  //  energy_rise          energy gained without external work, as a
+  //                       fraction of the energy scale (the kinetic energy
+  //                       and the springs' energy, plus the work to lift
+  //                       every dynamic body by its own size against gravity)
+  //  joint_drift          anchor separation (m) of a joint
+  //  joint_drift_angle    angle error (rad) of a joint
+  //  penetration_drift    contact penetration (m) beyond the slop
+  Real energy_rise = Real(0.1);
+  Real joint_drift = Real(0.05);
+  Real joint_drift_angle = Real(0.2);
+  Real penetration_drift = Real(0.05);
+
+  // Integrators (section 12.6.3 and 12.6.4).
+
   /// Integrators (section 12.6.3 and 12.6.4).
   Gyroscopic gyroscopic = Gyroscopic::ImplicitMidpoint;
   OrientationIntegrator orientation = OrientationIntegrator::ExponentialMap;
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

@@ -75,4 +75,4 @@ struct ShapeDesc {
   static ShapeDesc plane(const Vec3& n, Real d) { ShapeDesc s; s.type = ShapeType::Plane; s.normal = n; s.offset = d; return s; }  ///< the half-space n.x <= d (static bodies)
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

@@ -49,9 +49,10 @@ struct StepStats {
   int islands = 0;           ///< awake islands solved
   int sleeping_bodies = 0;
   double max_penetration = 0;  ///< deepest contact after the step (m)
+  double energy = 0;           ///< kinetic + potential (gravity, springs) after the step (J)
   int rows_by_kind[kRowKindCount] = {};
   double stage_seconds[kStageCount] = {};  ///< wall time per stage (summed over substeps)
   double wall_seconds = 0;                 ///< the whole step
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

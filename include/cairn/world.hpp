@@ -44,7 +44,7 @@ namespace cairn {
 namespace detail {
 class WorldImpl;
 struct WorldAccess;
-}  ///< namespace detail
+}  // namespace detail
 
 /// How a world starts: gravity and the solver settings.
 struct WorldDef {
@@ -245,4 +245,4 @@ class World {
   std::unique_ptr<detail::WorldImpl> impl_;
 };
 
-}  ///< namespace cairn
+}  // namespace cairn

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace cairn {
@@ -101,6 +102,45 @@ TEST(Hull, NonFinitePointIsRejectedByIndex) {
   } catch (const InputError& e) {
     EXPECT_NE(e.message().find("points[3] is not finite"), std::string::npos) << e.what();
   }
+}
+
+// A hull far from its shape's origin has the mass properties of the same
+// hull at the origin, moved: the sums are taken about the hull's own
+// vertex mean. About the far origin, a 0.1 m box 10 km out lost every digit
+// of its volume (tetrahedra of 1e12 m^3 summing to 1e-3 m^3) and was
+// refused as "degenerate inertia".
+TEST(Hull, FarFromTheOriginHasTheMassPropertiesOfTheSameHullNearIt) {
+  for (const Real far : {Real(1e4), Real(1e7)}) {
+    std::vector<Vec3> pts;
+    for (const Vec3& c : unitCubeCorners()) pts.push_back(Vec3(far, -far, 2 * far) + Real(0.1) * c);
+    ShapeDesc s;
+    s.type = ShapeType::ConvexHull;
+    s.hull = buildConvexHull(pts);
+    const MassProperties mp = shapeMassProperties(s, 1000);
+    // Box of side 0.1: m = 1000 x 1e-3 = 1 kg, I = m/6 a^2 on each axis.
+    // The corners are rounded to the ulp of the offset (2e-12 at 1e4,
+    // 2e-9 at 1e7), a relative error of 2e-11 or 2e-8 in a 0.1 m side;
+    // the tolerances are ten times those, times the power of the side in
+    // each quantity.
+    const Real rel = Real(10) * std::numeric_limits<Real>::epsilon() * far / Real(0.1);
+    EXPECT_NEAR(mp.mass, 1.0, 3 * rel) << far;
+    EXPECT_NEAR((mp.center - Vec3(far, -far, 2 * far)).norm(), 0, 2 * far * std::numeric_limits<Real>::epsilon()) << far;
+    const Real i = Real(1) / 6 * Real(0.01);
+    EXPECT_TRUE(mp.inertia.isApprox(i * Mat3::Identity(), 5 * rel)) << far << "\n" << mp.inertia;
+  }
+}
+
+TEST(Hull, MorePointsThanTheLimitAreRefusedBeforeQhullRuns) {
+  InputLimits limits;
+  limits.hull_points = 7;
+  try {
+    buildConvexHull(unitCubeCorners(), "body 'rock'", "shapes[0].points", limits);
+    FAIL() << "accepted 8 points with a limit of 7";
+  } catch (const InputError& e) {
+    EXPECT_NE(e.message().find("8 points exceed the limit (limit hull_points = 7"), std::string::npos) << e.what();
+  }
+  limits.hull_points = 8;
+  EXPECT_EQ(buildConvexHull(unitCubeCorners(), "", "points", limits)->vertices.size(), 8u);
 }
 
 }  // namespace

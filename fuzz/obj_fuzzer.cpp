@@ -1,0 +1,7 @@
+// libFuzzer entry point: Wavefront OBJ files (fuzz/targets.hpp).
+#include "fuzz/targets.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  (void)cairn::fuzz::objInput(data, size);
+  return 0;
+}

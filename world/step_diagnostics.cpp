@@ -1,0 +1,261 @@
+// The step's watchers: what goes wrong without a NaN, reported in
+// World::diagnostics (one record per body and kind, counting the steps it
+// happened in) and by `cairn run` on stderr and in the metrics.
+//
+//   energy rise       the total energy E = T + V (kinetic, gravity, springs)
+//                     grew without external work. Per step
+//                       dE = E(end) - E(start),
+//                     both from the same bodies (ctx.step_start holds the
+//                     state the step began from, after any change made
+//                     through the API, so a teleport or a new body is not
+//                     counted). The rise is the growth since the lowest
+//                     point of a stretch of steps without external work:
+//                       rise = max(0, rise + dE),
+//                     reset by any step with external work (constant
+//                     forces, forces applied through the API, timed
+//                     impulses, motors, moving kinematic bodies). Reported
+//                     when rise > energy_rise * S, with the energy scale
+//                       S = T + V_springs + sum_i m_i |g| L_i,
+//                     L_i = sqrt(tr J_i / (2 m_i)) the body's radius of
+//                     gyration: the energy in motion and in springs, and
+//                     the work to lift every body by its own size.
+//                     A push-out of a penetration of a few mm, or a joint's
+//                     Baumgarte correction, stays far below it; an
+//                     integrator or solver that feeds energy in does not.
+//   joint drift       a joint's anchors apart by more than joint_drift, or
+//                     its angle error beyond joint_drift_angle.
+//   penetration       a contact deeper than slop + penetration_drift after
+//                     the step: a stack sinking or a contact not resolved.
+//   fast body without CCD
+//                     a body without continuous collision moved, in one
+//                     step, further than its own thickness plus that of a
+//                     shape its path overlaps: it can pass through that
+//                     shape without ever touching it (the classic
+//                     tunnelling of discrete collision: Ericson, "Real-Time
+//                     Collision Detection", section 9.5; Bullet and Jolt
+//                     offer CCD for the same reason).
+//   exact solve too large
+//                     an island with method lcp over max_exact_rows rows,
+//                     solved by PGS instead that step (world/islands.cpp).
+//   contact pairs capped
+//                     a shape overlapped more than max_pairs_per_shape
+//                     others; the rest were not tested that step
+//                     (collision/broadphase.hpp).
+//
+// Each watcher reads what the step left behind and changes nothing in the
+// simulation: a World with the watchers' settings at infinity steps bit for
+// bit as one with their defaults.
+#include "collision/aabb.hpp"
+#include "constraints/parts.hpp"
+#include "dynamics/forces.hpp"
+#include "world/step_stages.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace cairn::detail {
+
+namespace {
+
+std::string fmt(Real v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
+Real springEnergyAt(const WorldImpl& w, const Spring& s, const StepContext* start) {
+  const auto point = [&](BodyId id, const Vec3& local) {
+    if (id.isWorld()) return local;
+    if (!start) return w.body(id).transform().apply(local);
+    const StepContext::SavedState& st = start->step_start[static_cast<size_t>(id.index)];
+    return Transform{st.x, st.q}.apply(local);
+  };
+  return springEnergy((point(s.def.body_b, s.local_b) - point(s.def.body_a, s.local_a)).norm(), s.rest_length,
+                      s.def.stiffness);
+}
+
+// T + V at the step's start (from ctx.step_start) or now.
+Real energy(const WorldImpl& w, const StepContext* start) {
+  Real e = 0;
+  for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    const Body& b = w.bodies_[i];
+    if (!b.alive || !b.isDynamic()) continue;
+    if (!start) {
+      e += b.kineticEnergy() - b.mass * w.gravity_.dot(b.position);
+      continue;
+    }
+    const StepContext::SavedState& st = start->step_start[i];
+    const Mat3 r = st.q.toRotationMatrix();
+    e += Real(0.5) * b.mass * st.v.squaredNorm() + Real(0.5) * st.w.dot(r * (b.inertia_body * (r.transpose() * st.w))) -
+         b.mass * w.gravity_.dot(st.x);
+  }
+  for (const Spring& s : w.springs_)
+    if (s.alive) e += springEnergyAt(w, s, start);
+  return e;
+}
+
+// Whether anything outside the bodies did work on them this step.
+bool externalWork(const WorldImpl& w, const StepContext& ctx) {
+  if (w.external_forces_) return true;
+  for (const Body& b : w.bodies_) {
+    if (!b.alive) continue;
+    if (b.type == BodyType::Kinematic && b.linear_velocity.squaredNorm() + b.angular_velocity.squaredNorm() > 0)
+      return true;
+    if (!b.isDynamic()) continue;
+    if (b.constant_force != Vec3::Zero() || b.constant_torque != Vec3::Zero()) return true;
+    // A timed impulse applied at this step's start (world/step_integrate.cpp).
+    if (b.next_impulse > 0 && b.impulses[b.next_impulse - 1].time > w.time_ - ctx.h) return true;
+  }
+  for (const Joint& j : w.joints_)
+    if (j.alive && !j.broken && (j.def.motor.enabled || !j.def.motor_axes.empty())) return true;
+  return false;
+}
+
+void watchEnergy(WorldImpl& w, StepContext& ctx) {
+  const Real before = energy(w, &ctx);
+  const Real after = energy(w, nullptr);
+  w.stats_.energy = after;
+  if (!std::isfinite(before) || !std::isfinite(after)) return;  // the guard reports non-finite states
+  if (externalWork(w, ctx)) {
+    w.energy_rise_ = 0;
+    return;
+  }
+  w.energy_rise_ = std::max(Real(0), w.energy_rise_ + (after - before));
+  Real scale = 0;
+  for (const Spring& s : w.springs_)
+    if (s.alive) scale += springEnergyAt(w, s, nullptr);
+  const Real g = w.gravity_.norm();
+  for (const Body& b : w.bodies_) {
+    if (!b.alive || !b.isDynamic() || b.asleep) continue;
+    scale += b.kineticEnergy() + b.mass * g * std::sqrt(std::max(Real(0), b.inertia_body.trace() / (2 * b.mass)));
+  }
+  if (!(w.energy_rise_ > w.settings_.energy_rise * scale) || scale <= 0) return;
+  w.diagnose(-1, "energy rise",
+             "energy rose by " + fmt(w.energy_rise_) + " J without external work (tolerance energy_rise = " +
+                 fmt(w.settings_.energy_rise) + " of the energy scale " + fmt(scale) +
+                 " J): an unstable integrator, solver or stiffness; try more substeps or a smaller dt", true);
+  w.energy_rise_ = 0;
+}
+
+void watchJoints(WorldImpl& w) {
+  const SolverSettings& s = w.settings_;
+  for (size_t i = 0; i < w.joints_.size(); ++i) {
+    const Joint& j = w.joints_[i];
+    if (!j.alive || j.broken) continue;
+    const BodyId a = j.def.body_a, b = j.def.body_b;
+    const bool awake = (!a.isWorld() && !w.body(a).asleep && w.body(a).isDynamic()) ||
+                       (!b.isWorld() && !w.body(b).asleep && w.body(b).isDynamic());
+    if (!awake) continue;
+    const JointError e = measureJointError(j, w.view(a), w.view(b));
+    if (!(e.linear > s.joint_drift) && !(e.angular > s.joint_drift_angle)) continue;
+    const BodyId on = b.isWorld() ? a : b;
+    w.diagnose(on.index, "joint drift",
+               "joint '" + j.def.name + "' apart by " + fmt(e.linear) + " m and " + fmt(e.angular) +
+                   " rad (tolerances joint_drift = " + fmt(s.joint_drift) + " m, joint_drift_angle = " +
+                   fmt(s.joint_drift_angle) + " rad): more iterations or substeps, or a smaller mass ratio", true);
+  }
+}
+
+void watchPenetration(WorldImpl& w) {
+  const SolverSettings& s = w.settings_;
+  const Real tolerance = s.slop + s.penetration_drift;
+  for (const Contact& c : w.contacts_) {
+    if (!c.enabled) continue;
+    const BodyId dyn = !c.body_b.isWorld() && w.body(c.body_b).isDynamic() ? c.body_b : c.body_a;
+    if (dyn.isWorld() || !w.body(dyn).isDynamic() || w.body(dyn).asleep) continue;
+    const BodyView a = w.view(c.body_a), b = w.view(c.body_b);
+    Real depth = 0;
+    for (int i = 0; i < c.count; ++i)
+      depth = std::max(depth, -(worldPoint(b, c.points[i].local_b) - worldPoint(a, c.points[i].local_a)).dot(c.normal));
+    if (!(depth > tolerance)) continue;
+    const BodyId other = dyn.index == c.body_a.index ? c.body_b : c.body_a;
+    w.diagnose(dyn.index, "penetration",
+               "penetrates '" + (other.isWorld() ? std::string("world") : w.body(other).name) + "' by " + fmt(depth) +
+                   " m (slop " + fmt(s.slop) + " + penetration_drift " + fmt(s.penetration_drift) +
+                   " m): a hard impact, a stack sinking or a contact not resolved; more iterations or substeps", true);
+  }
+}
+
+// Thickness of a shape: the smallest extent of its own box (0 for a
+// triangle mesh, whose triangles have none; infinite for a plane, a
+// half-space nothing passes).
+Real thickness(const ShapeDesc& shape) {
+  if (shape.type == ShapeType::Mesh) return 0;
+  if (shape.type == ShapeType::Plane) return kInf;
+  const Aabb box = shapeAabb(shape, Transform{});
+  return (box.hi - box.lo).minCoeff();
+}
+
+void watchFastBodies(WorldImpl& w, StepContext& ctx) {
+  for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    const Body& b = w.bodies_[i];
+    if (!b.alive || !b.isDynamic() || b.asleep || b.ccd || b.shapes.empty()) continue;
+    const Vec3 from = ctx.step_start[i].x, to = b.position;
+    const Real travel = (to - from).norm();
+    // Cheap test first: a body that moved less than its radius of gyration
+    // cannot have passed anything thinner than itself.
+    if (!(travel > Real(0.5) * std::sqrt(b.inertia_body.trace() / (2 * b.mass)))) continue;
+    Real own = kInf;
+    for (const ShapeDesc& s : b.shapes) own = std::min(own, thickness(s));
+    if (!(travel > own)) continue;
+    const Aabb path{from.cwiseMin(to), from.cwiseMax(to)};
+    std::int32_t passed = -1;
+    Real passed_thickness = 0;
+    w.broadphase_.query(path, [&](int proxy) {
+      const ShapeRef& ref = w.shapes_[static_cast<size_t>(w.broadphase_.user(proxy))];
+      if (!ref.alive || ref.body.index == static_cast<std::int32_t>(i)) return true;
+      const Real t = thickness(w.body(ref.body).shapes[static_cast<size_t>(ref.index)]);
+      if (!(travel > own + t)) return true;
+      passed = ref.body.index;
+      passed_thickness = t;
+      return false;
+    });
+    if (passed < 0) continue;
+    w.diagnose(static_cast<std::int32_t>(i), "fast body without CCD",
+               "moved " + fmt(travel) + " m in one step across '" + w.body(passed).name + "' (" +
+                   fmt(passed_thickness) + " m thick; the body " + fmt(own) +
+                   " m): it can pass through without touching; set ccd on the body or use a smaller dt", true);
+  }
+}
+
+void watchLimits(WorldImpl& w, StepContext& ctx) {
+  const SolverSettings& s = w.settings_;
+  if (s.method == SolverMethod::LCP) {
+    for (size_t isl = 0; isl < ctx.island_rows_estimate.size(); ++isl) {
+      if (ctx.island_rows_estimate[isl] <= s.max_exact_rows) continue;
+      std::int32_t first = -1;
+      for (size_t i = 0; i < ctx.body_island.size() && first < 0; ++i)
+        if (ctx.body_island[i] == static_cast<std::int32_t>(isl)) first = static_cast<std::int32_t>(i);
+      if (first >= 0)
+        w.diagnose(first, "exact solve too large",
+                   "its island has about " + std::to_string(ctx.island_rows_estimate[isl]) +
+                       " rows, over max_exact_rows = " + std::to_string(s.max_exact_rows) +
+                       " (the exact LCP is dense: memory ~ rows^2, time ~ rows^3): solved by PGS instead", true);
+    }
+  }
+  for (const int proxy : w.broadphase_.cappedProxies()) {
+    const ShapeRef& ref = w.shapes_[static_cast<size_t>(w.broadphase_.user(proxy))];
+    // A static shape's query is cut short under many bodies (a ground box),
+    // but each of them found it with its own query: nothing was lost.
+    if (!ref.alive || w.body(ref.body).type == BodyType::Static) continue;
+    w.diagnose(ref.body.index, "contact pairs capped",
+               "shape " + std::to_string(ref.index) + " overlapped more than max_pairs_per_shape = " +
+                   std::to_string(s.max_pairs_per_shape) +
+                   " other shapes; the rest were not tested (coincident or deeply overlapping bodies)", true);
+  }
+}
+
+}  // namespace
+
+void watchStep(WorldImpl& w, StepContext& ctx) {
+  watchEnergy(w, ctx);
+  watchJoints(w);
+  watchPenetration(w);
+  watchFastBodies(w, ctx);
+  watchLimits(w, ctx);
+  w.external_forces_ = false;
+}
+
+}  // namespace cairn::detail

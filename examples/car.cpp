@@ -68,11 +68,13 @@ int main() {
       cairn::JointDef axle;
       axle.name = wheel.name + "_axle";
       axle.type = cairn::JointType::Hinge;
-      axle.body_a = body;
-      axle.body_b = w;
+      axle.body_a = w;  // the motor drives the first body (the wheel) relative to the second (the chassis)
+      axle.body_b = body;
       axle.anchor = wheel.position;
       axle.axis = Vec3::UnitZ();
-      axle.motor = {true, -speed, torque};  // -z spin rolls the car towards +x
+      axle.motor.enabled = true;
+      axle.motor.target_velocity = -speed;  // -z spin rolls the car towards +x
+      axle.motor.max_force = torque;
       axles.push_back(world.createJoint(axle));
     }
 

@@ -36,7 +36,7 @@ int main() {
   cairn::JointDef hinge;
   hinge.name = "hinge";
   hinge.type = cairn::JointType::Hinge;
-  hinge.body_b = door_id;  // body_a: the world
+  hinge.body_a = door_id;  // body_b: the world; angle and motor measure the door relative to it
   hinge.anchor = {0, 1, 0};
   hinge.axis = {0, 1, 0};
   hinge.limit.enabled = true;

@@ -164,9 +164,27 @@ void checkJointDef(const JointDef& d, const std::string& obj) {
   }
   magnitude(obj, "swing_span1", d.swing_span1);
   magnitude(obj, "swing_span2", d.swing_span2);
-  if (d.motor.enabled) {
-    magnitude(obj, "motor.target_velocity", d.motor.target_velocity);
-    magnitude(obj, "motor.max_force", d.motor.max_force);
+  const auto motor = [&](const std::string& prefix, const MotorDef& m) {
+    if (!m.enabled) return;
+    magnitude(obj, prefix + "target_velocity", m.target_velocity);
+    optionalMagnitude(obj, prefix + "max_force", m.max_force);
+    optionalMagnitude(obj, prefix + "target_position", m.target_position);
+    softness(obj, prefix, m.softness);
+  };
+  motor("motor.", d.motor);
+  for (int i = 0; i < kDofCount; ++i) {  // six_dof axes
+    const DofDef& dof = d.dofs[static_cast<size_t>(i)];
+    const std::string prefix = std::string("dofs.") + dofName(i) + ".";
+    if (dof.mode == DofMode::Limited) {
+      magnitude(obj, prefix + "limits.lower", dof.limit.lower);
+      magnitude(obj, prefix + "limits.upper", dof.limit.upper);
+      softness(obj, prefix + "limits.", dof.limit.softness);
+    }
+    if (dof.spring.enabled) {
+      magnitude(obj, prefix + "spring.rest", dof.spring.rest);
+      softness(obj, prefix + "spring.", dof.spring.softness);
+    }
+    motor(prefix + "motor.", dof.motor);
   }
   for (size_t i = 0; i < d.motor_axes.size(); ++i) magnitude(obj, "motor[" + std::to_string(i) + "].axis", d.motor_axes[i]);
   for (size_t i = 0; i < d.motor_targets.size(); ++i)

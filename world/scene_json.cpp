@@ -49,6 +49,9 @@ class Reader {
     return j_.find(key).value();
   }
   std::string field(const std::string& key) const { return prefix_ + key; }
+  // A nested value its own Reader or parser checks (an object's type is
+  // checked by the Reader made from it).
+  const json& raw(const char* key) const { return required(key, "a value"); }
 
   Real number(const char* key) const { return numberOf(required(key, "a number"), key); }
   Real number(const char* key, Real def) const { return has(key) ? number(key) : def; }

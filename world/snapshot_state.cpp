@@ -35,10 +35,10 @@ namespace {
 
 // A new field changes these sizes (x86-64, libstdc++): the compiler then
 // points here, to add it below and bump kSnapshotVersion.
-static_assert(sizeof(SolverSettings) == 192, "SolverSettings changed: update snapshot_state.cpp");
+static_assert(sizeof(SolverSettings) == 232, "SolverSettings changed: update snapshot_state.cpp");
 static_assert(sizeof(Body) == 960, "Body changed: update snapshot_state.cpp");
 static_assert(sizeof(ShapeDesc) == 208, "ShapeDesc changed: update snapshot_state.cpp");
-static_assert(sizeof(Joint) == 928, "Joint changed: update snapshot_state.cpp");
+static_assert(sizeof(Joint) == 3456, "Joint changed: update snapshot_state.cpp");
 static_assert(sizeof(Spring) == 192, "Spring changed: update snapshot_state.cpp");
 static_assert(sizeof(ShapeRef) == 24, "ShapeRef changed: update snapshot_state.cpp");
 static_assert(sizeof(Contact) == 608, "Contact changed: update snapshot_state.cpp");
@@ -106,6 +106,12 @@ void io(Ar& ar, SolverSettings& s) {
   ar(s.max_angular_velocity);
   io(ar, s.gyroscopic, 4);
   io(ar, s.orientation, 2);
+  ar(s.max_pairs_per_shape);
+  ar(s.max_exact_rows);
+  ar(s.energy_rise);
+  ar(s.joint_drift);
+  ar(s.joint_drift_angle);
+  ar(s.penetration_drift);
 }
 
 // --- Geometry ---------------------------------------------------------------
@@ -295,9 +301,27 @@ void io(Ar& ar, Softness& s) {
 }
 
 template <class Ar>
+void io(Ar& ar, LimitDef& l) {
+  ar(l.enabled);
+  ar(l.lower);
+  ar(l.upper);
+  ar(l.restitution);
+  io(ar, l.softness);
+}
+
+template <class Ar>
+void io(Ar& ar, MotorDef& m) {
+  ar(m.enabled);
+  ar(m.target_velocity);
+  io(ar, m.max_force);
+  io(ar, m.target_position);
+  io(ar, m.softness);
+}
+
+template <class Ar>
 void io(Ar& ar, JointDef& d) {
   ar(d.name);
-  io(ar, d.type, 8);
+  io(ar, d.type, static_cast<int>(JointType::SixDof) + 1);
   io(ar, d.body_a);
   io(ar, d.body_b);
   io(ar, d.anchor);
@@ -306,16 +330,18 @@ void io(Ar& ar, JointDef& d) {
   io(ar, d.anchor_a);
   io(ar, d.anchor_b);
   io(ar, d.length);
-  ar(d.limit.enabled);
-  ar(d.limit.lower);
-  ar(d.limit.upper);
-  ar(d.limit.restitution);
-  io(ar, d.limit.softness);
+  io(ar, d.limit);
   ar(d.swing_span1);
   ar(d.swing_span2);
-  ar(d.motor.enabled);
-  ar(d.motor.target_velocity);
-  ar(d.motor.max_force);
+  io(ar, d.motor);
+  for (DofDef& dof : d.dofs) {
+    io(ar, dof.mode, 3);
+    io(ar, dof.limit);
+    ar(dof.spring.enabled);
+    ar(dof.spring.rest);
+    io(ar, dof.spring.softness);
+    io(ar, dof.motor);
+  }
   io(ar, d.motor_axes);
   io(ar, d.motor_targets);
   io(ar, d.motor_max_torques);
@@ -338,6 +364,8 @@ void io(Ar& ar, Joint& j) {
   io(ar, j.local_ref_a);
   io(ar, j.local_ref_b);
   io(ar, j.local_axis2_b);
+  io(ar, j.local_frame_a);
+  io(ar, j.local_frame_b);
   io(ar, j.rel_orientation0);
   ar(j.length);
   io(ar, j.local_motor_axes);

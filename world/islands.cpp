@@ -9,6 +9,7 @@
 // penetration, sleeps: its bodies stop integrating, its contacts keep their
 // cached state and make no rows, until something awake touches it or the
 // API wakes it.
+#include "world/method_choice.hpp"
 #include "world/step_stages.hpp"
 
 #include <algorithm>
@@ -115,7 +116,9 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
     ctx.body_island[static_cast<size_t>(i)] = isl;
   }
   ctx.island_method.assign(static_cast<size_t>(ctx.island_count), w.settings_.method);
+  chooseIslandMethods(w, ctx);
   if (w.settings_.method == SolverMethod::LCP) limitExactIslands(w, ctx);
+  countIslandMethods(w, ctx);
 }
 
 // The exact LCP is dense: its memory grows with the square of an island's

@@ -24,9 +24,11 @@
 //
 // so J dx = -C: the linearized constraint is met exactly. Repeated from
 // the moved pose it converges quadratically (a few steps from the
-// millimetres one velocity step leaves). Velocities are not touched:
-// the pass moves positions only, like split impulse, so it adds no
-// kinetic energy.
+// millimetres one velocity step leaves); a step that would raise the
+// largest error is taken back and halved (backtracking). The caller's
+// `move` also moves the velocities by dx / h, so they stay those of the
+// corrected positions, v = (x_{n+1} - x_n) / h, as position-based
+// dynamics updates them (Macklin, Mueller and Chentanez, "XPBD", MIG 2016).
 #pragma once
 
 #include "constraints/row.hpp"
@@ -43,6 +45,7 @@ struct PositionPassOptions {
   int max_iterations = 4;       // Newton steps at most
   Real tolerance = Real(1e-9);  // stop when every row's |C| (m or rad) is below this
   Real h = Real(1) / 60;        // the (sub)step the rows' rhs = -C/h was built with
+  int max_halvings = 4;         // backtracking: a step that does not lower the error is halved this often
 };
 
 struct PositionPassStats {

@@ -75,6 +75,12 @@ void correctJointPositions(WorldImpl& w, StepContext& ctx) {
       b.position += b.allowedLinear(d.v);
       b.orientation = (quatFromRotationVector(b.allowedAngular(d.w)) * b.orientation).normalized();
       b.updateDerived();
+      // The velocity follows the corrected position, v = (x_{n+1} - x_n) / h
+      // (position-based dynamics' update): a position moved without it
+      // leaves a velocity that pulls the joint open again next step, and
+      // on a whipping chain the two fight and pump energy in.
+      b.linear_velocity += b.allowedLinear(d.v) / h;
+      b.angular_velocity += b.allowedAngular(d.w) / h;
     }
   };
   ctx.position_bodies.resize(static_cast<size_t>(ctx.solver_count));

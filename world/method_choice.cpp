@@ -17,7 +17,9 @@
 //                by metres);
 //   joint_drift  a rigid joint of it is open by more than 1 cm at the
 //                step's start: PGS's residual did not fall last step (the
-//                extremes' hanging-chain limit, 2% of a 0.5 m link).
+//                extremes' hanging-chain limit, 2% of a 0.5 m link). Its
+//                bodies keep the mark (hysteresis): an island that holds
+//                only because it left PGS would drift again on return.
 //
 // Everything else stays PGS. An ill-conditioned island goes to the exact
 // pivoting LCP solver (solver/lcp_exact.hpp) when it has contacts and at
@@ -43,6 +45,7 @@ struct IslandFacts {
   Real min_mass = kInf, max_mass = 0;
   int joints = 0, contact_points = 0;
   Real joint_error = 0;
+  bool drifted = false;  // a body of it was marked by an earlier joint_drift
 };
 
 }  // namespace
@@ -56,10 +59,12 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
   const auto islandOf = [&](BodyId id) {
     return id.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(id.index)];
   };
+  ctx.body_drifted.resize(w.bodies_.size(), 0);
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
     const std::int32_t isl = ctx.body_island[i];
     if (isl < 0) continue;
     IslandFacts& f = facts[static_cast<size_t>(isl)];
+    f.drifted = f.drifted || ctx.body_drifted[i] != 0;
     f.min_mass = std::min(f.min_mass, w.bodies_[i].mass);
     f.max_mass = std::max(f.max_mass, w.bodies_[i].mass);
   }
@@ -82,12 +87,15 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
     MethodReason why = MethodReason::WellConditioned;
     if (f.max_mass >= kMassRatio * f.min_mass) why = MethodReason::MassRatio;
     else if (f.joints > kChainJointsPerSweep * s.iterations) why = MethodReason::LongChain;
-    else if (f.joint_error > kDriftLimit) why = MethodReason::JointDrift;
+    else if (f.drifted || f.joint_error > kDriftLimit) why = MethodReason::JointDrift;
     ctx.island_reason[isl] = why;
     if (why == MethodReason::WellConditioned || f.joints + f.contact_points == 0) {
       ctx.island_method[isl] = SolverMethod::PGS;
       continue;
     }
+    if (why == MethodReason::JointDrift)
+      for (size_t i = 0; i < w.bodies_.size(); ++i)
+        if (ctx.body_island[i] == static_cast<std::int32_t>(isl)) ctx.body_drifted[i] = 1;
     const int rows = 6 * f.joints + 3 * f.contact_points;  // at most
     const int exact_rows = std::min(kExactRows, s.max_exact_rows);
     ctx.island_method[isl] = f.contact_points > 0 && rows <= exact_rows ? SolverMethod::LCP : SolverMethod::Direct;

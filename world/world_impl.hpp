@@ -76,6 +76,7 @@ struct StepContext {
   int island_count = 0;
   std::vector<SolverMethod> island_method;  // how each island is solved this step
   std::vector<MethodReason> island_reason;  // and why (world/method_choice.cpp)
+  std::vector<char> body_drifted;           // per body slot: its island once left PGS for joint drift
 
   // Solver order (world/step_prepare.cpp): index 0 for the world and every
   // static body, then the awake dynamic bodies island by island (1 to

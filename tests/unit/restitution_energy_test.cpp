@@ -112,6 +112,7 @@ TEST(RestitutionEnergy, NoDropGainsEnergyWithAnyShapeSpinFrictionOrSubsteps) {
 // section 12.4.2). The restitution pass drives the normal velocity to its
 // target until the error is under 1e-6 of the target, so 1e-5 relative.
 TEST(RestitutionEnergy, HeadOnBouncesKeepTheExactCoefficient) {
+  int checked = 0;
   for (const Drop& base : allDrops()) {
     if (base.spin || base.restitution == 0 || (base.shape != Shape::Sphere && base.shape != Shape::BoxFace)) continue;
     BodyId id;
@@ -124,11 +125,13 @@ TEST(RestitutionEnergy, HeadOnBouncesKeepTheExactCoefficient) {
       const Real after = in.body(id).linear_velocity.y();
       if (before < 0 && after > 0) {
         bounced = true;
+        ++checked;
         EXPECT_NEAR(after, -base.restitution * before, 1e-5 * std::abs(before)) << base.label();
       }
     }
     EXPECT_TRUE(bounced) << base.label();
   }
+  EXPECT_EQ(checked, 24);  // sphere and box face, mu 0 and 0.5, e 0.5 and 1, 1, 2 and 4 substeps
 }
 
 }  // namespace

@@ -24,6 +24,15 @@ bool rigidBilateral(const ConstraintRow& r) {
 
 }  // namespace
 
+void recordJointErrors(WorldImpl& w, StepContext& ctx) {
+  ctx.joint_error_start.assign(w.joints_.size(), 0);
+  if (w.settings_.position_iterations <= 0) return;
+  for (size_t i = 0; i < w.joints_.size(); ++i) {
+    const Joint& j = w.joints_[i];
+    if (j.alive && !j.broken) ctx.joint_error_start[i] = measureJointError(j, w.view(j.def.body_a), w.view(j.def.body_b)).linear;
+  }
+}
+
 void correctJointPositions(WorldImpl& w, StepContext& ctx) {
   const SolverSettings& s = w.settings_;
   if (s.position_iterations <= 0 || ctx.island_count == 0) return;
@@ -35,8 +44,14 @@ void correctJointPositions(WorldImpl& w, StepContext& ctx) {
   joints.clear();
   for (size_t i = 0; i < w.joints_.size(); ++i) {
     const Joint& j = w.joints_[i];
-    if (j.alive && !j.broken && !j.def.softness.isSet() && i < ctx.joint_island.size() && corrected(ctx.joint_island[i]))
-      joints.push_back(static_cast<std::int32_t>(i));
+    if (!j.alive || j.broken || j.def.softness.isSet() || i >= ctx.joint_island.size() || !corrected(ctx.joint_island[i]))
+      continue;
+    // A joint that was apart by more than max_correction_velocity h when
+    // the substep began is left to its velocity rows, which close it at
+    // that capped speed (the safety net of docs/extremes.md); the pass
+    // takes over for the last substep's worth.
+    if (i < ctx.joint_error_start.size() && ctx.joint_error_start[i] > s.max_correction_velocity * ctx.hs) continue;
+    joints.push_back(static_cast<std::int32_t>(i));
   }
   if (joints.empty()) return;
 

@@ -95,6 +95,7 @@ void WorldImpl::step(Real h) {
     guardBodies(*this, ctx, "velocity integration");
     clock.lap(Stage::Guards);
     stiffenRotations(*this, ctx);    // 5a
+    recordJointErrors(*this, ctx);
     prepareConstraints(*this, ctx);  // 5
     clock.lap(Stage::BuildRows);
     solveConstraints(*this, ctx);  // 6

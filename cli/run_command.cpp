@@ -1,5 +1,5 @@
 // `cairn run SCENE.json [--steps N] [--dt H] [--out traj.csv] [--every K]
-//  [--metrics m.json] [--method pgs|direct|lcp] [--substeps N]
+//  [--metrics m.json] [--method auto|pgs|direct|lcp] [--substeps N]
 //  [--iterations N] [--limit NAME=N ...] [--save-state FILE]`: simulate a
 // scene and write its trajectory; `cairn run --restore FILE --steps N [...]`
 // goes on from a snapshot that --save-state wrote (docs/snapshots.md),
@@ -73,6 +73,11 @@ struct RunFigures {
   int energy_every = 1;
   Real energy_min = kInf, energy_max = -kInf;
   std::vector<Real> energy;
+  // Island-steps per solver method and per reason (world/method_choice.cpp).
+  long islands_by_method[kSolverMethodCount] = {};
+  long islands_by_reason[kMethodReasonCount] = {};
+  long position_iterations = 0;
+  Real position_error_max = 0;
 
   void record(const World& w) {
     const StepStats& st = w.lastStepStats();
@@ -85,6 +90,10 @@ struct RunFigures {
     if (w.time() >= last_second_from - 1e-12) penetration_last_second = std::max(penetration_last_second, st.max_penetration);
     iterations += st.iterations;
     for (int k = 0; k < kStageCount; ++k) stage_seconds[k] += st.stage_seconds[k];
+    for (int k = 0; k < kSolverMethodCount; ++k) islands_by_method[k] += st.islands_by_method[k];
+    for (int k = 0; k < kMethodReasonCount; ++k) islands_by_reason[k] += st.islands_by_reason[k];
+    position_iterations += st.position_iterations;
+    position_error_max = std::max(position_error_max, st.position_error);
     residual_final = st.residual;
     residual_max = std::max(residual_max, st.residual);
     rows_max = std::max(rows_max, st.rows);
@@ -125,6 +134,30 @@ struct RunFigures {
     nlohmann::json series = nlohmann::json::array();
     for (const Real e : energy) series.push_back(figure(e));
     m["energy"] = series;
+    nlohmann::json by_method = nlohmann::json::object(), by_reason = nlohmann::json::object();
+    for (int k = 0; k < kSolverMethodCount; ++k)
+      if (islands_by_method[k] > 0) by_method[solverMethodName(static_cast<SolverMethod>(k))] = islands_by_method[k];
+    for (int k = 0; k < kMethodReasonCount; ++k)
+      if (islands_by_reason[k] > 0) by_reason[methodReasonName(static_cast<MethodReason>(k))] = islands_by_reason[k];
+    m["island_steps_by_method"] = by_method;
+    m["island_steps_by_reason"] = by_reason;
+    m["position_pass_iterations_total"] = position_iterations;
+    m["position_pass_error_max"] = position_error_max;
+  }
+
+  // "pgs 540, direct 60 (mass_ratio 60)": what solved the islands, and why.
+  std::string islandSummary() const {
+    std::string s;
+    for (int k = 0; k < kSolverMethodCount; ++k)
+      if (islands_by_method[k] > 0)
+        s += std::string(s.empty() ? "" : ", ") + solverMethodName(static_cast<SolverMethod>(k)) + " " +
+             std::to_string(islands_by_method[k]);
+    std::string why;
+    for (int k = 0; k < kMethodReasonCount; ++k)
+      if (islands_by_reason[k] > 0)
+        why += std::string(why.empty() ? "" : ", ") + methodReasonName(static_cast<MethodReason>(k)) + " " +
+               std::to_string(islands_by_reason[k]);
+    return s.empty() ? "no islands" : s + " (" + why + ")";
   }
 };
 
@@ -263,7 +296,10 @@ int runScene(const RunOptions& opt) {
   if (traj) traj->commit();
   if (metrics) metrics->commit();
   std::cout << source << ": " << world.stepCount() << " steps of " << scene.dt << " s, "
-            << world.bodyCount() << " bodies, " << 1e3 * wall / std::max(1, world.stepCount() - first_step) << " ms/step\n";
+            << world.bodyCount() << " bodies, " << 1e3 * wall / std::max(1, world.stepCount() - first_step)
+            << " ms/step\n"
+            << "  island-steps by solver: " << fig.islandSummary() << "; largest joint error "
+            << fig.joint_linear_max << " m\n";
   return 0;
 }
 

@@ -5,7 +5,7 @@
 namespace cairn::cli {
 
 void addSolverOverrideOptions(CLI::App& cmd, SolverOverrides& o) {
-  cmd.add_option("--method", o.method, "Solver: pgs, direct (CHOLMOD + PGS) or lcp (exact); overrides solver.method");
+  cmd.add_option("--method", o.method, "Solver: auto (per island), pgs, direct (CHOLMOD + PGS) or lcp (exact); overrides solver.method");
   cmd.add_option("--substeps", o.substeps, "Substeps per step (overrides solver.substeps)");
   cmd.add_option("--iterations", o.iterations, "PGS iterations per (sub)step (overrides solver.iterations)");
 }

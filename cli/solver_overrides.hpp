@@ -1,4 +1,4 @@
-// `--method pgs|direct|lcp`, `--substeps N` and `--iterations N` for
+// `--method auto|pgs|direct|lcp`, `--substeps N` and `--iterations N` for
 // `cairn run` and `cairn validate`: the scene file's solver.method,
 // solver.substeps and solver.iterations, set from the command line through
 // the same table as `cairn sweep --vary` (validation/solver_keys.hpp).

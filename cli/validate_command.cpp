@@ -1,5 +1,5 @@
 // `cairn validate SCENE... [--against bullet] [--report DIR] [--steps N]
-//  [--method pgs|direct|lcp] [--substeps N] [--iterations N]`:
+//  [--method auto|pgs|direct|lcp] [--substeps N] [--iterations N]`:
 // run each scene in cairn and in Bullet with matched settings and compare
 // them (validation/compare.hpp), with closed forms where they exist.
 //

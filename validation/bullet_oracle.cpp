@@ -225,7 +225,7 @@ void BulletOracle::Impl::configureSolver() {
   btContactSolverInfo& info = world->getSolverInfo();
   const SolverSettings& s = solver;
   info.m_numIterations = s.iterations;
-  if (s.method != SolverMethod::PGS)
+  if (s.method != SolverMethod::PGS && s.method != SolverMethod::Auto)  // auto: PGS unless an island needs more
     skipped.push_back(std::string("solver.method=") + solverMethodName(s.method) +
                       " has no Bullet equivalent: Bullet runs btSequentialImpulseConstraintSolver (PGS) with " +
                       std::to_string(s.iterations) + " iterations");

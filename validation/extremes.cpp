@@ -186,10 +186,20 @@ const char* driftMeasureName(DriftMeasure m) {
 }
 
 std::vector<SettingVariant> standardVariants() {
-  return {{"pgs 50 it", [](SolverSettings& s) { s.iterations = 50; }},
-          {"pgs 10 it x 4 sub", [](SolverSettings& s) { s.substeps = 4; }},
+  return {{"pgs", [](SolverSettings& s) { s.method = SolverMethod::PGS; }},
+          {"pgs 50 it",
+           [](SolverSettings& s) {
+             s.method = SolverMethod::PGS;
+             s.iterations = 50;
+           }},
+          {"pgs 10 it x 4 sub",
+           [](SolverSettings& s) {
+             s.method = SolverMethod::PGS;
+             s.substeps = 4;
+           }},
           {"pgs 20 it x 8 sub",
            [](SolverSettings& s) {
+             s.method = SolverMethod::PGS;
              s.iterations = 20;
              s.substeps = 8;
            }},
@@ -210,6 +220,14 @@ std::vector<ExtremeCase> extremeCases() {
   for (Real r : {10, 100, 1000, 10000})
     out.push_back(make("chain-ratio-" + fmtG(r), "10-link ball chain, tip " + fmtG(r) + " kg, released horizontally",
                        chainWithEndWeight(10, r), DriftMeasure::JointSeparation));
+  // Heavy weights on long light chains (scenarios::heavyHangingChain: 40
+  // rods of 0.5 m, 1 kg, the last R kg, nudged 5 cm/s), and a stack whose
+  // boxes grow eightfold in mass upward (1:4096 top to bottom).
+  for (Real r : {100, 1000, 10000})
+    out.push_back(make("heavy-chain-40-" + fmtG(r), "40 hanging 0.5 m rods of 1 kg, the last " + fmtG(r) + " kg, nudged",
+                       scenarios::heavyHangingChain(40, r), DriftMeasure::JointSeparation));
+  out.push_back(make("doubling-stack-5", "5 cubes, edge doubling upward from 0.25 m (1:4096)", scenarios::doublingStack(5),
+                     DriftMeasure::Displacement));
   // Time steps, 3 s of simulated time each.
   for (int hz : {1000, 240, 60, 30, 15}) {
     out.push_back(make("column-10-dt-1/" + std::to_string(hz), "column-10 at h = 1/" + std::to_string(hz) + " s, 3 s",

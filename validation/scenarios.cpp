@@ -141,6 +141,26 @@ SceneDesc pile(int per_side) {
   return s;
 }
 
+SceneDesc heavyHangingChain(int links, Real ratio) {
+  SceneDesc s = hangingChain(links);
+  s.bodies.back().mass = ratio;
+  s.bodies.back().linear_velocity = Vec3(Real(0.05), 0, 0);
+  return s;
+}
+
+SceneDesc doublingStack(int boxes) {
+  SceneDesc s = base(600);
+  s.bodies.push_back(ground());
+  Real edge = Real(0.25), y = 0;
+  for (int k = 0; k < boxes; ++k, edge *= 2) {
+    BodyDef b = box("box_" + std::to_string(k), Vec3(0, y + edge / 2, 0), 1000 * edge * edge * edge);
+    b.shapes[0] = ShapeDesc::box(Vec3::Constant(edge / 2));
+    s.bodies.push_back(b);
+    y += edge;
+  }
+  return s;
+}
+
 std::vector<std::string> standardNames() {
   return {"pyramid-10", "pyramid-20", "column-10", "column-20", "chain-20", "chain-100",
           "hanging-chain-20", "hinge-pendulum-0.1", "hinge-pendulum-1.5", "mass-ratio-100",
@@ -154,6 +174,12 @@ SceneDesc byName(const std::string& key) {
   try {
     if (starts("pyramid-")) return pyramid(std::stoi(tail("pyramid-")));
     if (starts("column-")) return column(std::stoi(tail("column-")));
+    if (starts("heavy-chain-")) {
+      const std::string t = tail("heavy-chain-");
+      const auto dash = t.find('-');
+      if (dash != std::string::npos) return heavyHangingChain(std::stoi(t.substr(0, dash)), std::stod(t.substr(dash + 1)));
+    }
+    if (starts("doubling-stack-")) return doublingStack(std::stoi(tail("doubling-stack-")));
     if (starts("hanging-chain-")) return hangingChain(std::stoi(tail("hanging-chain-")));
     if (starts("chain-")) return chain(std::stoi(tail("chain-")));
     if (starts("hinge-pendulum-")) return hingePendulum(std::stod(tail("hinge-pendulum-")));

@@ -32,6 +32,9 @@ SceneDesc motorLimits();                       // motor-limits: a hinge and a sl
 SceneDesc sixDof();                            // six-dof: a cube on a six_dof with one axis of each kind
 SceneDesc ramp();                              // ramp: boxes on 20 and 35 degree ramps, mu 0.5
 SceneDesc restitutionDrop(Real restitution);   // restitution-drop: a sphere of e dropped 2 m on the ground
+// Mass-ratio extremes (docs/extremes.md, "Heavy chains" and "auto"):
+SceneDesc heavyHangingChain(int links, Real ratio);  // heavy-chain-N-R: N rods of 0.5 m (1 kg) hanging, the last R kg, nudged 5 cm/s
+SceneDesc doublingStack(int boxes);            // doubling-stack-N: cubes whose edge doubles upward from 0.25 m (density 1000)
 
 // Scenario by key ("pyramid-10", "column-20", "chain-100",
 // "hinge-pendulum-0.1", "mass-ratio-1000", "pile-1000", ...); the sized

@@ -52,6 +52,8 @@ Json solverJson(const SolverSettings& s) {
   Json j;
   j["method"] = solverMethodName(s.method);
   j["iterations"] = s.iterations;
+  j["position_iterations"] = s.position_iterations;
+  j["geometric_stiffness"] = s.geometric_stiffness;
   j["tolerance"] = s.tolerance;
   j["sor"] = s.sor;
   j["warm_start"] = s.warm_start;

@@ -92,12 +92,12 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
   switch (k->type) {
     case Type::Method: {
       bool found = false;
-      for (SolverMethod m : {SolverMethod::PGS, SolverMethod::Direct, SolverMethod::LCP})
+      for (SolverMethod m : {SolverMethod::Auto, SolverMethod::PGS, SolverMethod::Direct, SolverMethod::LCP})
         if (value == solverMethodName(m)) {
           s.method = m;
           found = true;
         }
-      if (!found) bad(option, value, "is not a method (pgs, direct or lcp)");
+      if (!found) bad(option, value, "is not a method (auto, pgs, direct or lcp)");
       break;
     }
     case Type::Int: {

@@ -9,6 +9,7 @@
 // penetration, sleeps: its bodies stop integrating, its contacts keep their
 // cached state and make no rows, until something awake touches it or the
 // API wakes it.
+#include "world/method_choice.hpp"
 #include "world/step_stages.hpp"
 
 #include <algorithm>
@@ -16,6 +17,10 @@
 namespace cairn::detail {
 
 namespace {
+
+// A push-out is done when what is left of it is under 1% of the slop
+// (5e-5 m at the default 5 mm).
+constexpr Real kPushDone = Real(0.01);
 
 std::int32_t findRoot(std::vector<std::int32_t>& parent, std::int32_t i) {
   while (parent[static_cast<size_t>(i)] != i) {
@@ -115,7 +120,9 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
     ctx.body_island[static_cast<size_t>(i)] = isl;
   }
   ctx.island_method.assign(static_cast<size_t>(ctx.island_count), w.settings_.method);
+  chooseIslandMethods(w, ctx);
   if (w.settings_.method == SolverMethod::LCP) limitExactIslands(w, ctx);
+  countIslandMethods(w, ctx);
 }
 
 // The exact LCP is dense: its memory grows with the square of an island's
@@ -168,9 +175,29 @@ void updateSleep(WorldImpl& w, StepContext& ctx) {
     }
     // An island being pushed out of a penetration deeper than the slop
     // stays awake until the push-out is done: asleep it would keep the
-    // penetration for good.
-    for (size_t isl = 0; isl < ctx.island_pushing.size() && isl < island_min.size(); ++isl)
-      if (ctx.island_pushing[isl]) island_min[isl] = 0;
+    // penetration for good. Done means: no contact deeper than the slop by
+    // more than kPushDone of it, and no body moved by its pseudo-velocity
+    // (split impulse) by more than that in the last substep. The push-out
+    // closes the excess geometrically (by 1 - contact_erp a step), so it
+    // is never exactly zero: a tolerance lets a finished push-out sleep.
+    const Real done = kPushDone * s.slop;
+    for (const Contact& c : w.contacts_) {
+      if (!c.enabled || c.count == 0) continue;
+      const std::int32_t isl = std::max(c.body_a.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(c.body_a.index)],
+                                        c.body_b.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(c.body_b.index)]);
+      if (isl < 0) continue;
+      const BodyView a = w.view(c.body_a), b = w.view(c.body_b);
+      for (int i = 0; i < c.count; ++i) {
+        const Real depth = -(worldPoint(b, c.points[i].local_b) - worldPoint(a, c.points[i].local_a)).dot(c.normal);
+        if (depth > s.slop + done) island_min[static_cast<size_t>(isl)] = 0;
+      }
+    }
+    for (std::int32_t si = 1; si <= ctx.dynamic_count && si < static_cast<std::int32_t>(ctx.pseudo.size()); ++si) {
+      const SolverBody& p = ctx.pseudo[static_cast<size_t>(si)];
+      if (ctx.hs * p.v.norm() <= done) continue;
+      const std::int32_t isl = ctx.body_island[static_cast<size_t>(ctx.body_of_solver[static_cast<size_t>(si)])];
+      if (isl >= 0) island_min[static_cast<size_t>(isl)] = 0;
+    }
     // An island touching a moving kinematic body stays awake.
     for (const Contact& c : w.contacts_) {
       for (const auto& [kin, dyn] : {std::pair{c.body_a, c.body_b}, std::pair{c.body_b, c.body_a}}) {

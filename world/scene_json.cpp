@@ -478,7 +478,8 @@ SolverMethod parseMethod(const Reader& r, const std::string& s) {
   if (s == "pgs") return SolverMethod::PGS;
   if (s == "direct") return SolverMethod::Direct;
   if (s == "lcp") return SolverMethod::LCP;
-  r.fail("method", "must be pgs, direct or lcp (got '" + s + "')");
+  if (s == "auto") return SolverMethod::Auto;
+  r.fail("method", "must be auto, pgs, direct or lcp (got '" + s + "')");
 }
 
 SolverSettings parseSolver(const json& j) {
@@ -486,6 +487,8 @@ SolverSettings parseSolver(const json& j) {
   SolverSettings s;
   if (r.has("method")) s.method = parseMethod(r, r.string("method"));
   s.iterations = r.intIn("iterations", s.iterations, 1);
+  s.position_iterations = r.intIn("position_iterations", s.position_iterations, 0);
+  s.geometric_stiffness = r.boolean("geometric_stiffness", s.geometric_stiffness);
   s.tolerance = r.number("tolerance", s.tolerance);
   s.sor = r.number("sor", s.sor);
   s.warm_start = r.boolean("warm_start", s.warm_start);

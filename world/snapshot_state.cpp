@@ -77,8 +77,10 @@ void io(Ar& ar, Aabb& b) {
 
 template <class Ar>
 void io(Ar& ar, SolverSettings& s) {
-  io(ar, s.method, 3);
+  io(ar, s.method, 4);
   ar(s.iterations);
+  ar(s.position_iterations);
+  ar(s.geometric_stiffness);
   ar(s.tolerance);
   ar(s.sor);
   ar(s.warm_start);

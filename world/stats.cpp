@@ -19,4 +19,16 @@ const char* stageName(Stage s) {
   return "unknown";
 }
 
+const char* methodReasonName(MethodReason r) {
+  switch (r) {
+    case MethodReason::Setting: return "setting";
+    case MethodReason::WellConditioned: return "well_conditioned";
+    case MethodReason::MassRatio: return "mass_ratio";
+    case MethodReason::LongChain: return "long_chain";
+    case MethodReason::JointDrift: return "joint_drift";
+    case MethodReason::Count: break;
+  }
+  return "unknown";
+}
+
 }  // namespace cairn

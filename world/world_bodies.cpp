@@ -37,6 +37,7 @@ const char* solverMethodName(SolverMethod m) {
     case SolverMethod::PGS: return "pgs";
     case SolverMethod::Direct: return "direct";
     case SolverMethod::LCP: return "lcp";
+    case SolverMethod::Auto: return "auto";
   }
   return "unknown";
 }
@@ -108,6 +109,8 @@ void validateShape(const std::string& obj, const std::string& f, const ShapeDesc
 void validateSettings(const SolverSettings& s) {
   const std::string o = "solver";
   if (s.iterations < 1) throw InputError(o, "iterations", "must be >= 1 (got " + std::to_string(s.iterations) + ")");
+  if (s.position_iterations < 0)
+    throw InputError(o, "position_iterations", "must be >= 0 (got " + std::to_string(s.position_iterations) + ")");
   if (s.substeps < 1) throw InputError(o, "substeps", "must be >= 1 (got " + std::to_string(s.substeps) + ")");
   if (s.threads < 1 || s.threads > 64)
     throw InputError(o, "threads", "must lie in [1, 64] (got " + std::to_string(s.threads) + ")");

@@ -75,6 +75,8 @@ struct StepContext {
   std::vector<std::int32_t> uf_parent;
   int island_count = 0;
   std::vector<SolverMethod> island_method;  // how each island is solved this step
+  std::vector<MethodReason> island_reason;  // and why (world/method_choice.cpp)
+  std::vector<char> body_drifted;           // per body slot: its island once left PGS for joint drift
 
   // Solver order (world/step_prepare.cpp): index 0 for the world and every
   // static body, then the awake dynamic bodies island by island (1 to
@@ -109,6 +111,15 @@ struct StepContext {
   std::vector<ConstraintRow> rows;
   std::vector<std::pair<std::int32_t, std::int32_t>> island_rows;  // row range per island (empty for PGS islands)
   std::vector<Real> correction_lambda;  // their correction passes' impulses
+
+  // The joint position pass (world/joint_position_pass.cpp).
+  std::vector<std::int32_t> position_joints;
+  std::vector<Real> joint_error_start;  // per joint: anchor separation as the substep began
+  std::vector<ConstraintRow> position_rows, position_scratch;
+  std::vector<SolverBody> position_bodies;
+  // Geometric stiffness per body slot (world/geometric_stiffness.cpp).
+  std::vector<Mat3> stiffness;
+  bool any_stiffness = false;
 
   // The non-finite guard (world/step_guard.cpp).
   struct SavedState {
@@ -269,6 +280,7 @@ class WorldImpl {
 
   StepContext ctx_;
   DirectSolver direct_solver_;  // keeps CHOLMOD's symbolic analysis while the structure holds
+  DirectSolver position_solver_;  // the joint position pass's own (its rows' pattern differs)
   std::unique_ptr<WorkerPool> pool_;
   std::uint64_t rng_state_ = 0;
   bool rng_seeded_ = false;

@@ -9,10 +9,13 @@
 //   for each of the n substeps (h / n each):
 //     4. velocities   v* = v + h M^-1 f (gravity, gyroscopic term, damping)
 //     5. prepare      joint rows and contact constraints, island by island
+//                     (direct and exact islands: with the joints' geometric
+//                     stiffness in their inertia, restored after the solve)
 //     6. solve        v = v* + M^-1 J^T lambda (PGS over the coloured
 //                     constraint graph, or a direct or exact solve per
 //                     island); then the position-correction passes
-//     7. positions    x += h v, q <- exp(h w) q
+//     7. positions    x += h v, q <- exp(h w) q; then the joint position
+//                     pass of direct and exact islands (Newton on C(x) = 0)
 //     8. impulses     kept for warm starting; joint feedback and breaking
 //   9. restitution  once, from the approach speeds at detection
 //  10. events, sleep, clear accumulators
@@ -23,6 +26,8 @@
 // went non-finite (its bodies go back to the step's start, at rest) and lets
 // the other islands step on (docs/extremes.md, "Safety nets").
 #include "cairn/error.hpp"
+#include "world/geometric_stiffness.hpp"
+#include "world/position_pass_stage.hpp"
 #include "world/step_stages.hpp"
 
 #include <chrono>
@@ -89,13 +94,18 @@ void WorldImpl::step(Real h) {
     clock.lap(Stage::Integrate);
     guardBodies(*this, ctx, "velocity integration");
     clock.lap(Stage::Guards);
+    stiffenRotations(*this, ctx);    // 5a
+    recordJointErrors(*this, ctx);
     prepareConstraints(*this, ctx);  // 5
     clock.lap(Stage::BuildRows);
     solveConstraints(*this, ctx);  // 6
+    restoreRotations(*this, ctx);    // 6a
     clock.lap(Stage::Solve);
     guardSolve(*this, ctx);
     clock.lap(Stage::Guards);
     integratePositions(*this, ctx);  // 7
+    clock.lap(Stage::Integrate);
+    correctJointPositions(*this, ctx);  // 7b
     clock.lap(Stage::Integrate);
     guardBodies(*this, ctx, "position integration");
     clock.lap(Stage::Guards);

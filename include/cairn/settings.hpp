@@ -45,13 +45,23 @@ enum class Simd { Auto, Portable, Avx2, Avx512 };
 
 const char* simdName(Simd s);  ///< lower-case name, as in scene files
 
-enum class SolverMethod { PGS, Direct, LCP };  ///< PGS, the CHOLMOD direct solver or the exact LCP (docs/solvers-exact.md)
+/// How an island's rows are solved: PGS sweeps over the coloured graph, the
+/// direct (CHOLMOD) block solve, the exact pivoting LCP solve
+/// (docs/solvers-exact.md), or Auto: PGS unless the island is
+/// ill-conditioned for it (world/method_choice.cpp).
+enum class SolverMethod { PGS, Direct, LCP, Auto };
 
 const char* solverMethodName(SolverMethod m);  ///< lower-case name, as in scene files
 /// The solver settings of a World (World::setSettings).
 struct SolverSettings {
-  SolverMethod method = SolverMethod::PGS;  ///< the velocity solver
+  SolverMethod method = SolverMethod::Auto;  ///< the velocity solver, per island (world/method_choice.cpp)
   int iterations = 10;          ///< PGS sweeps per step (Bullet: 10)
+  /// Newton steps of the nonlinear joint position pass after each (sub)step,
+  /// for islands solved directly or exactly (solver/position_pass.hpp); 0: off.
+  int position_iterations = 4;
+  /// Direct and exact islands: the joints' geometric stiffness in the
+  /// inertia the velocity solve sees (world/geometric_stiffness.cpp).
+  bool geometric_stiffness = true;
   Real tolerance = 0;           ///< early exit when no impulse changed by more than this in a sweep (N s); 0 = never
   Real sor = 1;                 ///< successive over-relaxation factor, (0, 2)
   bool warm_start = true;       ///< start from last step's impulses

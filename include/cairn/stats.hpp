@@ -39,6 +39,20 @@ enum class Stage : std::uint8_t {
 };
 inline constexpr int kStageCount = static_cast<int>(Stage::Count);  ///< number of stages
 const char* stageName(Stage s);  ///< lower-case name
+
+/// Why an island got its solver method (world/method_choice.cpp).
+enum class MethodReason : std::uint8_t {
+  Setting,          ///< solver.method names one method for every island
+  WellConditioned,  ///< auto: nothing PGS cannot carry within its sweeps
+  MassRatio,        ///< auto: heaviest / lightest body of the island >= 100
+  LongChain,        ///< auto: more joints than 4 x the PGS sweeps
+  JointDrift,       ///< auto: a rigid joint open by more than 1 cm at the step's start
+  Count
+};
+inline constexpr int kMethodReasonCount = static_cast<int>(MethodReason::Count);  ///< number of reasons
+const char* methodReasonName(MethodReason r);  ///< lower-case name
+inline constexpr int kSolverMethodCount = 4;  ///< SolverMethod's PGS, Direct, LCP, Auto
+
 /// What the last step reports (World::lastStepStats).
 struct StepStats {
   int iterations = 0;        ///< PGS sweeps done (summed over substeps)
@@ -50,6 +64,10 @@ struct StepStats {
   int sleeping_bodies = 0;
   double max_penetration = 0;  ///< deepest contact after the step (m)
   double energy = 0;           ///< kinetic + potential (gravity, springs) after the step (J)
+  int position_iterations = 0;  ///< Newton steps of the joint position pass (summed over substeps)
+  double position_error = 0;    ///< largest joint row error |C| the position pass left (m or rad)
+  int islands_by_method[kSolverMethodCount] = {};  ///< islands solved by each SolverMethod (Auto never)
+  int islands_by_reason[kMethodReasonCount] = {};  ///< why (MethodReason)
   int rows_by_kind[kRowKindCount] = {};
   double stage_seconds[kStageCount] = {};  ///< wall time per stage (summed over substeps)
   double wall_seconds = 0;                 ///< the whole step

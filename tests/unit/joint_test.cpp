@@ -79,6 +79,7 @@ TEST(BallChain, SinglePassBaumgarteGrowsUnderPlainPgsWhereTwoPassSettles) {
   const auto run = [](Correction c, bool nncg) {
     World w = hangingChain(20, 10);
     SolverSettings s = w.settings();
+    s.method = SolverMethod::PGS;  // the PGS correction modes themselves
     s.position_correction = c;
     s.nncg = nncg;
     w.setSettings(s);
@@ -107,6 +108,7 @@ TEST(BallChain, HorizontalWhipErrorFallsWithIterations) {
   for (int it : {4, 20, 100}) {
     World w;
     SolverSettings s;
+    s.method = SolverMethod::PGS;  // PGS's convergence in its sweeps
     s.iterations = it;
     w.setSettings(s);
     for (int k = 0; k < 20; ++k) {

@@ -219,7 +219,7 @@ TEST(Sweep, MergeOfPartsThatDoNotBelongTogetherExitsTwo) {
 TEST(Sweep, PgsApproachesTheExactLcpAsIterationsGrowOnChain20) {
   TempDir tmp;
   const CliResult r =
-      cairn("sweep chain-20 --vary iterations=1,8,64,200 --steps 60 --exact-every 10 --out " + tmp / "chain", tmp);
+      cairn("sweep chain-20 --vary method=pgs --vary iterations=1,8,64,200 --steps 60 --exact-every 10 --out " + tmp / "chain", tmp);
   ASSERT_EQ(r.status, 0) << r.err;
   const auto rows = readCsv(tmp / "chain/sweep.csv");
   ASSERT_EQ(rows.size(), 8u);

@@ -1,0 +1,86 @@
+// Geometric stiffness of the joints' rotations, for the islands solved
+// directly or exactly (docs/extremes.md, "Heavy chains"), after Tournier,
+// Nesme, Gilles and Faure, "Stable Constrained Dynamics", ACM TOG 34(4)
+// (SIGGRAPH 2015), sections 4 and 5.
+//
+// A joint force f (world frame, last substep's) acting at the lever arm r
+// of a body exerts the torque tau = r x f. When the body turns by dtheta
+// the arm turns with it (dr = dtheta x r) while f keeps its direction
+// (the point rows lie along world axes), so
+//
+//   d tau / d theta = [f]x [r]x = r f^T - (f . r) I,
+//
+// and the stiffness K = (f . r) I - r f^T. For a rod hung by its ends
+// under tension T, K = T L/2 (I - u u^T) at each end: a torsion spring
+// holding it in line, of rate sqrt(6 T / (m L)) for a rod of mass m and
+// length L. The velocity solve treats this force explicitly (its
+// Jacobian is that of the step's start), which is stable only while h
+// times the rate stays below 2: 1:100 at h = 1/60 on 0.5 m links of 1 kg
+// gives 1.8, 1:1000 gives 5.7, and the light links' swing grows every
+// step until the chain tears. Tournier et al. move K into the implicit
+// solve: the rows see the body's inertia as I + h^2 K, the backward-Euler
+// treatment of the spring, stable at any h (it damps the stiff mode, as
+// implicit Euler damps any spring it steps past). K is made symmetric and
+// its negative eigenvalues are dropped (their section 5: a compressed
+// joint's K is indefinite, and only the positive part is kept so the
+// augmented inertia stays positive definite).
+//
+// The augmented inverse inertia replaces the body's in the rows of this
+// substep (stiffenRotations, before the rows are built) and the true one
+// comes back after the solve (restoreRotations): the integrators, the
+// energy and the position pass all see the body's real inertia.
+#include "world/geometric_stiffness.hpp"
+
+#include <Eigen/Eigenvalues>
+
+namespace cairn::detail {
+
+namespace {
+
+bool stiffened(const StepContext& ctx, std::int32_t isl) {
+  return isl >= 0 && ctx.island_method[static_cast<size_t>(isl)] != SolverMethod::PGS &&
+         !(ctx.any_frozen && ctx.frozen_island[static_cast<size_t>(isl)]);
+}
+
+Mat3 stiffness(const Vec3& f, const Vec3& r) { return f.dot(r) * Mat3::Identity() - r * f.transpose(); }
+
+}  // namespace
+
+void stiffenRotations(WorldImpl& w, StepContext& ctx) {
+  ctx.stiffness.assign(w.bodies_.size(), Mat3::Zero());
+  ctx.any_stiffness = false;
+  if (!w.settings_.geometric_stiffness) return;
+  for (const Joint& j : w.joints_) {
+    if (!j.alive || j.broken || j.def.softness.isSet()) continue;
+    for (const auto& [id, local, f] : {std::tuple{j.def.body_a, j.local_anchor_a, j.feedback.force_a},
+                                       std::tuple{j.def.body_b, j.local_anchor_b, j.feedback.force_b}}) {
+      if (id.isWorld() || !stiffened(ctx, ctx.body_island[static_cast<size_t>(id.index)])) continue;
+      const Body& b = w.bodies_[static_cast<size_t>(id.index)];
+      if (b.rotation_locked) continue;
+      ctx.stiffness[static_cast<size_t>(id.index)] += stiffness(f, b.orientation * local);
+      ctx.any_stiffness = true;
+    }
+  }
+  if (!ctx.any_stiffness) return;
+  const Real h2 = ctx.hs * ctx.hs;
+  for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    const Mat3& k = ctx.stiffness[i];
+    if (k.isZero(0)) continue;
+    Eigen::SelfAdjointEigenSolver<Mat3> es(Mat3(Real(0.5) * (k + k.transpose())));
+    const Vec3 positive = es.eigenvalues().cwiseMax(Real(0));
+    if (!(positive.maxCoeff() > 0)) continue;
+    Body& b = w.bodies_[i];
+    const Mat3 inertia = b.rotation * b.inertia_body * b.rotation.transpose();
+    const Mat3 augmented = inertia + h2 * es.eigenvectors() * positive.asDiagonal() * es.eigenvectors().transpose();
+    b.inv_inertia_world = augmented.inverse();
+  }
+}
+
+void restoreRotations(WorldImpl& w, StepContext& ctx) {
+  if (!ctx.any_stiffness) return;
+  for (size_t i = 0; i < w.bodies_.size(); ++i)
+    if (!ctx.stiffness[i].isZero(0)) w.bodies_[i].updateDerived();
+  ctx.any_stiffness = false;
+}
+
+}  // namespace cairn::detail

@@ -212,7 +212,7 @@ std::vector<SettingVariant> standardVariants() {
 
 std::vector<ExtremeCase> extremeCases() {
   std::vector<ExtremeCase> out;
-  // Mass ratios in stacks (SCENARIOS.md mass-ratio-R: a box of R kg on a 1 kg box).
+  // Mass ratios in stacks (docs/scenarios.md mass-ratio-R: a box of R kg on a 1 kg box).
   for (Real r : {10, 100, 1000, 10000})
     out.push_back(make("stack-ratio-" + fmtG(r), "box of " + fmtG(r) + " kg on a 1 kg box", scenarios::massRatio(r),
                        DriftMeasure::Displacement));

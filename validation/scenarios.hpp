@@ -26,7 +26,7 @@ SceneDesc pile(int per_side);                  // pile-N for N = per_side^3 (pil
 // table's common conditions itself (no sleeping).
 SceneDesc hingeChain(int links);               // hinge-chain: 5 planks on hinges, released from 0.3 rad
 SceneDesc door(Real max_torque);               // door: a box door on a vertical motorised hinge with limits
-SceneDesc ragdoll(bool six_dof);               // ragdoll: boxes and capsules, cone-twist and hinge joints (or
+SceneDesc ragdoll(bool six_dof = false);             // ragdoll: boxes and capsules, cone-twist and hinge joints (or
                                                // ragdoll-6dof: six_dof joints), dropped
 SceneDesc motorLimits();                       // motor-limits: a hinge and a slider motor driving into asymmetric limits
 SceneDesc sixDof();                            // six-dof: a cube on a six_dof with one axis of each kind

@@ -28,7 +28,7 @@ constexpr Key kKeys[] = {
     {"contact_erp", Type::Real},  {"sor", Type::Real},          {"tolerance", Type::Real},
     {"warm_start", Type::Bool},   {"warm_start_factor", Type::Real}, {"randomize_order", Type::Bool},
     {"split_impulse", Type::Bool}, {"slop", Type::Real},        {"nncg", Type::Bool},
-    {"sleeping", Type::Bool},
+    {"sleeping", Type::Bool},     {"geometric_stiffness", Type::Bool}, {"position_iterations", Type::Int},
 };
 
 const Key* findKey(const std::string& name) {
@@ -106,6 +106,7 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
       if (value.empty() || ec != std::errc() || end != value.data() + value.size())
         bad(option, value, "is not an integer");
       if (key == "substeps") s.substeps = v;
+      else if (key == "position_iterations") s.position_iterations = v;
       else s.iterations = v;
       break;
     }
@@ -117,6 +118,7 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
       else if (key == "randomize_order") s.randomize_order = v;
       else if (key == "nncg") s.nncg = v;
       else if (key == "sleeping") s.sleeping = v;
+      else if (key == "geometric_stiffness") s.geometric_stiffness = v;
       else s.split_impulse = v;
       break;
     }
@@ -164,6 +166,8 @@ std::string solverKeyValue(const SceneDesc& scene, const std::string& key) {
   if (key == "slop") return exactNumberText(s.slop);
   if (key == "nncg") return s.nncg ? "true" : "false";
   if (key == "sleeping") return s.sleeping ? "true" : "false";
+  if (key == "geometric_stiffness") return s.geometric_stiffness ? "true" : "false";
+  if (key == "position_iterations") return std::to_string(s.position_iterations);
   throw InputError("solver", key, "unknown setting");
 }
 

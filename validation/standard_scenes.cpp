@@ -70,7 +70,7 @@ StandardScene standardScene(const std::string& key) {
   StandardScene out;
   out.scene = scenarios::byName(key);  // throws InputError for an unknown key
   SceneDesc& s = out.scene;
-  s.solver.sleeping = false;  // SCENARIOS.md: no sleeping
+  s.solver.sleeping = false;  // docs/scenarios.md: no sleeping
   const std::string steps = std::to_string(s.steps) + " steps of 1/60 s (" + fixed(s.steps / 60.0, 0) + " s)";
   const std::string common = "Units SI (m, kg, s, rad), y up, g = 9.81 m/s^2 down, friction 0.5, no sleeping; ";
   Json v;

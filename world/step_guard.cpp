@@ -167,6 +167,9 @@ std::string solveCulprit(const WorldImpl& w, const StepContext& ctx, std::int32_
 }  // namespace
 
 void WorldImpl::diagnose(std::int32_t body, const char* kind, const std::string& detail, bool once_per_step) {
+  // A restored snapshot brings its diagnostics but not the step each was
+  // last counted in.
+  if (diagnostic_last_step_.size() < diagnostics_.size()) diagnostic_last_step_.resize(diagnostics_.size(), -1);
   for (size_t i = 0; i < diagnostics_.size(); ++i) {
     Diagnostic& d = diagnostics_[i];
     if (d.body.index != body || d.kind != kind) continue;

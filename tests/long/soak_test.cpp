@@ -91,7 +91,9 @@ TEST(Soak, MixedSceneHundredThousandStepsStaysFiniteFlatAndBounded) {
   hinge.body_b = plate_id;
   hinge.anchor = plate.position;
   hinge.axis = Vec3::UnitZ();
-  hinge.motor = {true, 2, 20};
+  hinge.motor.enabled = true;
+  hinge.motor.target_velocity = 2;
+  hinge.motor.max_force = 20;
   w.createJoint(hinge);
   const Real plate_izz = *plate.mass * (0.5 * 0.5 + 0.5 * 0.5) / 3;  // box about its axis: m (a^2 + b^2) / 3
   const Real motor_energy = 0.5 * plate_izz * 2 * 2;

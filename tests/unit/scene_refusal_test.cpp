@@ -61,7 +61,7 @@ TEST(SceneRefusal, MissingRequiredKeysNameTheFieldAndWhatItNeeds) {
                 "missing: an array of 3 numbers");
   expectRefused("\"radius\": 0.2", "\"position\": [0, 0, 0]", "body 'b'", "shapes[0].radius", "missing: a number");
   expectRefused(", \"stiffness\": 10", "", "spring 's'", "stiffness", "missing: a number");
-  expectRefused(", \"max_force\": 5", "", "joint 'h'", "motor.max_force", "missing: a number");
+  expectRefused(", \"max_force\": 5", "", "joint 'h'", "motor.max_force", "missing: a motor needs its largest force (N) or torque (N m)");
   expectRefused(", \"upper\": 1", "", "joint 'h'", "limits.upper", "missing: a number");
   expectRefused("{\"type\": \"box\", ", "{", "body 'a'", "shapes[0].type", "missing: a string");
   expectRefused("\"type\": \"hinge\", ", "", "joint 'h'", "type", "missing: a string");

@@ -301,9 +301,11 @@ TEST(WorldApi, TeleportedStaticBodiesCollideWhereTheyNowAre) {
   w.setTransform(s, Vec3(0, 2.5, 0), Quat::Identity());  // box top at y = 3
   w.setTransform(f, Vec3(0, 20, 0), Quat::Identity());   // the floor plane up to y = 0
   for (int i = 0; i < 180; ++i) w.step(kH);
-  const Real slop = w.settings().slop;  // resting contacts keep up to this penetration
-  EXPECT_NEAR(w.centerOfMass(ball).y(), 3.5, slop + 1e-6);
-  EXPECT_NEAR(w.centerOfMass(ball2).y(), 0.5, slop + 1e-6);
+  // Resting contacts keep up to the slop of penetration, plus the 1% of it
+  // the push-out may still have to go when the island falls asleep.
+  const Real slop = w.settings().slop;
+  EXPECT_NEAR(w.centerOfMass(ball).y(), 3.5, 1.01 * slop);
+  EXPECT_NEAR(w.centerOfMass(ball2).y(), 0.5, 1.01 * slop);
 }
 
 }  // namespace

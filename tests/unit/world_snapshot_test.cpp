@@ -109,8 +109,10 @@ TEST(WorldSnapshot, AnotherVersionTruncatedOrCorruptedIsRefusedAndChangesNothing
   w.step(1.0 / 60);  // a different state, to see that it stays
 
   std::vector<std::uint8_t> version = good;
-  version[8] = 2;
-  expectRefused(w, version, "version", "snapshot format version 2; this cairn reads version 1");
+  version[8] = static_cast<std::uint8_t>(detail::kSnapshotVersion + 1);  // little-endian: the low byte
+  expectRefused(w, version, "version",
+                "snapshot format version " + std::to_string(detail::kSnapshotVersion + 1) + "; this cairn reads version " +
+                    std::to_string(detail::kSnapshotVersion));
   std::vector<std::uint8_t> truncated(good.begin(), good.begin() + static_cast<long>(good.size() / 2));
   expectRefused(w, truncated, "payload", "truncated snapshot");
   expectRefused(w, std::vector<std::uint8_t>(good.begin(), good.begin() + 10), "header", "truncated snapshot");

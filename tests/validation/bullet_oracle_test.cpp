@@ -377,7 +377,7 @@ TEST(BulletOracle, CollisionMaskLetsABodyFallThrough) {
 // ------------------------------------------------------------------ joints
 
 // The standard hinge pendulum released from 0.1 rad: the period of the
-// small-amplitude cube pendulum is 2.168155 s (SCENARIOS.md). Semi-implicit
+// small-amplitude cube pendulum is 2.168155 s (docs/scenarios.md). Semi-implicit
 // Euler at h = 1/60 and Bullet's Baumgarte pivot correction move it by a
 // fraction of a percent; 2% is the bar set for cairn too.
 TEST(BulletOracle, HingePendulumPeriodMatchesTheExactPeriod) {
@@ -847,7 +847,7 @@ TEST(BulletOracle, BadSceneThrowsInputError) {
 
 // A pyramid of 55 boxes in Bullet for 10 s, awake throughout: the reference
 // cairn's stacking is compared with. It must stand (no box moved more than
-// 0.5 m, SCENARIOS.md's collapse criterion).
+// 0.5 m, docs/scenarios.md's collapse criterion).
 TEST(BulletOracle, LongPyramid10StandsForTenSeconds) {
   SceneDesc scene = scenarios::pyramid(10);
   scene.solver.sleeping = false;

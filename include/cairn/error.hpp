@@ -12,7 +12,11 @@ namespace cairn {
 /// Bad input: names the object and the field.
 class InputError : public std::runtime_error {
  public:
-  InputError(std::string object, std::string field, const std::string& message)  ///< object, field and what is wrong with it
+  /// Bad input in one field of one object.
+  /// @param object  the object at fault, e.g. "body 'crate'"; may be empty
+  /// @param field   which field of it, e.g. "shapes[1].radius"; may be empty
+  /// @param message what is wrong with it
+  InputError(std::string object, std::string field, const std::string& message)
       : std::runtime_error(compose(object, field, message)),
         object_(std::move(object)),
         field_(std::move(field)),
@@ -22,7 +26,12 @@ class InputError : public std::runtime_error {
   const std::string& field() const { return field_; }  ///< e.g. "shapes[1].radius"; may be empty
   const std::string& message() const { return message_; }  ///< what is wrong, without object and field
 
-  static std::string compose(const std::string& object, const std::string& field,  ///< the one-line message what() returns
+  /// The one-line message what() returns: "object: field 'field': message",
+  /// leaving out the parts that are empty.
+  /// @param object  as for the constructor
+  /// @param field   as for the constructor
+  /// @param message as for the constructor
+  static std::string compose(const std::string& object, const std::string& field,
                              const std::string& message) {
     std::string s;
     if (!object.empty()) s += object;

@@ -1,12 +1,13 @@
-// Limits on the size of input, each checked before anything is allocated
-// for what it counts, so that an oversized scene or mesh is refused with an
-// InputError that names the limit instead of exhausting memory
-// (std::bad_alloc) or running for hours. docs/reliability.md lists them and
-// why each default is what it is; `cairn run --limit NAME=VALUE` sets them
-// from the command line (inputLimitNames() below is that table).
-//
-// They bound the cost of loading and of one step, not what a scene may
-// mean: raise one when a real scene needs more.
+/// @file
+/// Limits on the size of input, each checked before anything is allocated
+/// for what it counts, so that an oversized scene or mesh is refused with an
+/// InputError that names the limit instead of exhausting memory
+/// (std::bad_alloc) or running for hours. docs/reliability.md lists them and
+/// why each default is what it is; `cairn run --limit NAME=VALUE` sets them
+/// from the command line (inputLimitNames() below is that table).
+///
+/// They bound the cost of loading and of one step, not what a scene may
+/// mean: raise one when a real scene needs more.
 #pragma once
 
 #include "cairn/error.hpp"
@@ -18,18 +19,19 @@
 
 namespace cairn {
 
+/// The limits on the size of input (see the file's description); defaults as documented in docs/reliability.md.
 struct InputLimits {
-  std::uint64_t bodies = 10000;            // bodies in a scene
-  std::uint64_t shapes_per_body = 1000;    // shapes of one (compound) body
-  std::uint64_t joints = 10000;            // joints in a scene
-  std::uint64_t springs = 100000;          // springs in a scene
-  std::uint64_t hull_points = 10000;       // input points of one convex hull
-  std::uint64_t mesh_vertices = 3000000;   // `v` records of one OBJ file
-  std::uint64_t mesh_triangles = 1000000;  // triangles of one OBJ file (after fanning)
-  std::uint64_t json_depth = 64;           // nesting of arrays and objects in a scene file
-  std::uint64_t file_bytes = 256u << 20;   // size of a scene or OBJ file (256 MiB)
-  std::uint64_t iterations = 10000;        // solver.iterations (sweeps per (sub)step)
-  std::uint64_t substeps = 1000;           // solver.substeps
+  std::uint64_t bodies = 10000;            ///< bodies in a scene
+  std::uint64_t shapes_per_body = 1000;    ///< shapes of one (compound) body
+  std::uint64_t joints = 10000;            ///< joints in a scene
+  std::uint64_t springs = 100000;          ///< springs in a scene
+  std::uint64_t hull_points = 10000;       ///< input points of one convex hull
+  std::uint64_t mesh_vertices = 3000000;   ///< `v` records of one OBJ file
+  std::uint64_t mesh_triangles = 1000000;  ///< triangles of one OBJ file (after fanning)
+  std::uint64_t json_depth = 64;           ///< nesting of arrays and objects in a scene file
+  std::uint64_t file_bytes = 256u << 20;   ///< size of a scene or OBJ file (256 MiB)
+  std::uint64_t iterations = 10000;        ///< solver.iterations (sweeps per (sub)step)
+  std::uint64_t substeps = 1000;           ///< solver.substeps
 };
 
 // Ranges of values a step can carry in double precision, checked when a
@@ -46,21 +48,21 @@ struct InputLimits {
 // A squared norm of a position (1e40 at most) is nowhere near overflow
 // (|x| > 1.3e154). Physically the range spans far below an atom to far
 // beyond a galaxy, so no meaningful scene is refused.
-inline constexpr double kMaxMagnitude = 1e20;
-inline constexpr double kMinSize = 1e-20;
+inline constexpr double kMaxMagnitude = 1e20;  ///< largest magnitude of a dimensional input (SI units)
+inline constexpr double kMinSize = 1e-20;      ///< smallest size, mass or density that meets an inertia (SI units)
 // An inertia tensor is m L^2: its eigenvalues lie in kMinSize^3..kMaxMagnitude^3.
-inline constexpr double kMaxInertia = 1e60;
-inline constexpr double kMinInertia = 1e-60;
+inline constexpr double kMaxInertia = 1e60;   ///< largest inertia eigenvalue (kg m^2)
+inline constexpr double kMinInertia = 1e-60;  ///< smallest inertia eigenvalue (kg m^2)
 
-// One row of the table of limits: its name on the command line, what it
-// counts (for --help), and the member it sets.
+/// One row of the table of limits: its name on the command line, what it
+/// counts (for --help), and the member it sets.
 struct InputLimitName {
-  const char* name;
-  const char* counts;
-  std::uint64_t InputLimits::*member;
+  const char* name;    ///< the limit's name, e.g. "bodies" (--limit NAME=VALUE)
+  const char* counts;  ///< what it counts, for --help
+  std::uint64_t InputLimits::*member;  ///< the InputLimits member it sets
 };
 
-// Every limit, in the order of the struct.
+/// Every limit, in the order of the struct.
 inline const std::vector<InputLimitName>& inputLimitNames() {
   static const std::vector<InputLimitName> kNames = {
       {"bodies", "bodies in a scene", &InputLimits::bodies},
@@ -78,16 +80,16 @@ inline const std::vector<InputLimitName>& inputLimitNames() {
   return kNames;
 }
 
-// "(limit NAME = N; raise it with --limit NAME=...)": the tail of every
-// message that refuses input for exceeding a limit.
+/// "(limit NAME = N; raise it with --limit NAME=...)": the tail of every
+/// message that refuses input for exceeding a limit.
 inline std::string limitHint(const char* name, std::uint64_t value) {
   return std::string("(limit ") + name + " = " + std::to_string(value) + "; raise it with --limit " + name +
          "=N or InputLimits::" + name + ")";
 }
 
-// Sets one limit from "NAME=VALUE" (VALUE a decimal integer >= 1). Throws
-// InputError naming `option` when the name is unknown or the value is not
-// such an integer.
+/// Sets one limit from "NAME=VALUE" (VALUE a decimal integer >= 1). Throws
+/// InputError naming `option` when the name is unknown or the value is not
+/// such an integer.
 inline void setInputLimit(InputLimits& limits, const std::string& assignment, const std::string& option = "--limit") {
   const size_t eq = assignment.find('=');
   const std::string name = assignment.substr(0, eq);

@@ -16,13 +16,13 @@ class World;
 /// A whole scene: gravity, step, solver settings, bodies, springs, joints.
 struct SceneDesc {
   std::string path;  ///< where it was read from, for messages ("" if built in code)
-  Vec3 gravity = Vec3(0, Real(-9.81), 0);
-  Real dt = Real(1) / 60;
-  int steps = 600;
-  SolverSettings solver;
-  std::vector<BodyDef> bodies;
-  std::vector<SpringDef> springs;
-  std::vector<JointDef> joints;
+  Vec3 gravity = Vec3(0, Real(-9.81), 0);  ///< m/s^2
+  Real dt = Real(1) / 60;  ///< time step (s)
+  int steps = 600;         ///< steps `cairn run` takes
+  SolverSettings solver;   ///< the World's solver settings
+  std::vector<BodyDef> bodies;     ///< in file order
+  std::vector<SpringDef> springs;  ///< in file order
+  std::vector<JointDef> joints;    ///< in file order
   std::string validation_json;  ///< the raw "validation" block, read by validation/
 
   int bodyIndex(const std::string& name) const {  ///< index in bodies, -1 when none

@@ -68,7 +68,7 @@ struct SolverSettings {
   Real warm_start_factor = 1;   ///< scale applied to the carried impulses
   bool randomize_order = false; ///< shuffle rows each sweep (seeded, reproducible)
   bool nncg = true;             ///< PGS with NNCG momentum between sweeps (solver/pgs.cpp); false: plain PGS as Bullet
-  std::uint64_t seed = 1;
+  std::uint64_t seed = 1;       ///< seed of the random row order (randomize_order): same seed, same run
   int substeps = 1;             ///< sub-steps per step
   int threads = 1;              ///< worker threads for the step (results are bit-identical for any count)
   Simd simd = Simd::Auto;       ///< contact solver instruction set
@@ -76,7 +76,7 @@ struct SolverSettings {
 
   /// ODE-style softness: rows drive J v toward -ERP/h C, CFM softens them.
   Real erp = Real(0.2);
-  Real cfm = 0;
+  Real cfm = 0;  ///< global CFM, ODE's units (m/(N s) for a linear row); 0: rigid rows
   /// Position correction of joint rows without a softness of their own:
   ///  VelocityBias   Baumgarte: -ERP/h C joins the velocities, solved in a
   ///                 second pass that is never warm-started (default)
@@ -119,8 +119,8 @@ struct SolverSettings {
   //                       the rows are built as 3 per contact point, 3 more
   //                       per rolling contact and 6 per joint; a larger
   //                       island is solved by PGS for that step
-  int max_pairs_per_shape = 64;
-  int max_exact_rows = 300;
+  int max_pairs_per_shape = 64;  ///< broadphase pairs one shape may make per step (see above)
+  int max_exact_rows = 300;      ///< largest island, in estimated rows, the exact LCP solves (see above)
 
   // Watchers (world/step_diagnostics.cpp): what goes wrong silently,
   // reported in World::diagnostics.
@@ -131,16 +131,14 @@ struct SolverSettings {
   //  joint_drift          anchor separation (m) of a joint
   //  joint_drift_angle    angle error (rad) of a joint
   //  penetration_drift    contact penetration (m) beyond the slop
-  Real energy_rise = Real(0.1);
-  Real joint_drift = Real(0.05);
-  Real joint_drift_angle = Real(0.2);
-  Real penetration_drift = Real(0.05);
-
-  // Integrators (section 12.6.3 and 12.6.4).
+  Real energy_rise = Real(0.1);        ///< energy gained, fraction of the energy scale (see above)
+  Real joint_drift = Real(0.05);       ///< joint anchor separation, m
+  Real joint_drift_angle = Real(0.2);  ///< joint angle error, rad
+  Real penetration_drift = Real(0.05); ///< contact penetration beyond the slop, m
 
   /// Integrators (section 12.6.3 and 12.6.4).
   Gyroscopic gyroscopic = Gyroscopic::ImplicitMidpoint;
-  OrientationIntegrator orientation = OrientationIntegrator::ExponentialMap;
+  OrientationIntegrator orientation = OrientationIntegrator::ExponentialMap;  ///< how the orientation follows w
 };
 
 }  // namespace cairn

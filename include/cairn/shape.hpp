@@ -23,17 +23,18 @@
 
 namespace cairn {
 
-enum class ShapeType { Sphere, Box, Capsule, Cylinder, Plane, ConvexHull, Mesh };  ///< the kinds of shape
+/// The kinds of shape (the table above).
+enum class ShapeType { Sphere, Box, Capsule, Cylinder, Plane, ConvexHull, Mesh };
 
 const char* shapeTypeName(ShapeType t);  ///< lower-case name, as in scene files
 
 /// A convex polyhedron: vertices, faces as vertex loops (counter-clockwise
 /// seen from outside) and one outward unit plane per face (n, d: n.x = d).
 struct ConvexHullData {
-  std::vector<Vec3> vertices;
-  std::vector<std::vector<int>> faces;
-  std::vector<Vec3> face_normals;
-  std::vector<Real> face_offsets;
+  std::vector<Vec3> vertices;  ///< shape frame (m)
+  std::vector<std::vector<int>> faces;  ///< each a loop of vertex indices, counter-clockwise seen from outside
+  std::vector<Vec3> face_normals;  ///< outward unit normal n of each face
+  std::vector<Real> face_offsets;  ///< d of each face's plane n.x = d (m)
   /// Unique edges as vertex index pairs (for the separating-axis test).
   std::vector<std::array<int, 2>> edges;
 };
@@ -41,18 +42,19 @@ struct ConvexHullData {
 /// A static triangle mesh (level geometry), triangles counter-clockwise seen
 /// from the side that pushes bodies out.
 struct TriangleMeshData {
-  std::vector<Vec3> vertices;
-  std::vector<std::array<int, 3>> triangles;
+  std::vector<Vec3> vertices;  ///< shape frame (m)
+  std::vector<std::array<int, 3>> triangles;  ///< vertex indices, counter-clockwise seen from the pushing side
 
   /// Optional bounding volume hierarchy over the triangles, filled by
   /// buildMeshBvh() (collision/mesh_bvh.hpp; loadObjMesh does it). Empty:
   /// the narrowphase tests every triangle.
   struct BvhNode {
-    Vec3 lo, hi;  ///< bounds of the node's triangles
+    Vec3 lo;      ///< lower corner of the bounds of the node's triangles
+    Vec3 hi;      ///< upper corner of those bounds
     int first;    ///< leaf: start in bvh_order; inner: index of the left child (right = first + 1)
     int count;    ///< leaf: number of triangles; inner: 0
   };
-  std::vector<BvhNode> bvh;
+  std::vector<BvhNode> bvh;  ///< the nodes, root first; empty: no hierarchy
   std::vector<int> bvh_order;  ///< triangle indices, grouped by leaf
 };
 /// A collision shape: its type, its sizes, its pose in the body frame.

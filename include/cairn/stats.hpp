@@ -59,16 +59,16 @@ struct StepStats {
   double residual = 0;       ///< natural-map LCP residual after the solve (max norm, last substep)
   int rows = 0;              ///< rows solved (last substep)
   int contacts = 0;          ///< touching manifolds
-  int contact_points = 0;
+  int contact_points = 0;    ///< points of the touching manifolds
   int islands = 0;           ///< awake islands solved
-  int sleeping_bodies = 0;
+  int sleeping_bodies = 0;   ///< bodies asleep after the step
   double max_penetration = 0;  ///< deepest contact after the step (m)
   double energy = 0;           ///< kinetic + potential (gravity, springs) after the step (J)
   int position_iterations = 0;  ///< Newton steps of the joint position pass (summed over substeps)
   double position_error = 0;    ///< largest joint row error |C| the position pass left (m or rad)
   int islands_by_method[kSolverMethodCount] = {};  ///< islands solved by each SolverMethod (Auto never)
   int islands_by_reason[kMethodReasonCount] = {};  ///< why (MethodReason)
-  int rows_by_kind[kRowKindCount] = {};
+  int rows_by_kind[kRowKindCount] = {};  ///< rows of each RowKind (last substep; they sum to rows)
   double stage_seconds[kStageCount] = {};  ///< wall time per stage (summed over substeps)
   double wall_seconds = 0;                 ///< the whole step
 };

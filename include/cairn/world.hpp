@@ -54,15 +54,17 @@ struct WorldDef {
 
 /// A contact of a body, as World::contacts(BodyId) reports it after a step.
 struct ContactData {
-  BodyId body_a, body_b;  ///< the normal points from a to b
-  ShapeId shape_a, shape_b;
-  Vec3 normal = Vec3::UnitY();
+  BodyId body_a;    ///< the body of shape_a; the normal points from a to b
+  BodyId body_b;    ///< the body of shape_b
+  ShapeId shape_a;  ///< the shape of body_a in contact
+  ShapeId shape_b;  ///< the shape of body_b in contact
+  Vec3 normal = Vec3::UnitY();  ///< world, unit, from a to b
   int count = 0;               ///< points, 1 to 4
   Vec3 points[4];              ///< world points midway between the surfaces
   Real depths[4] = {};         ///< penetration at detection (m, > 0 overlapping)
   Real normal_impulses[4] = {};  ///< N s over the last step
   Vec3 friction_impulses[4];     ///< N s over the last step, world vectors
-  bool touching = false;
+  bool touching = false;  ///< some point within the contact margin in the last step
 };
 /// The simulation: bodies, shapes, joints, springs, and the step.
 class World {

@@ -564,6 +564,18 @@ void ioWorld(Ar& ar, WorldImpl& w) {
   io(ar, w.break_events_);
   io(ar, w.numerical_events_);
   io(ar, w.diagnostics_);
+  // The watchers' running state, so a restored world reports as the
+  // original would (world/step_diagnostics.cpp), and auto's memory of
+  // islands that left PGS for joint drift (world/method_choice.cpp).
+  ar.at("watchers");
+  ioEach(ar, w.diagnostic_last_step_, [&ar](int& x) { ar(x); });
+  ar(w.energy_rise_);
+  ar(w.external_forces_);
+  ioEach(ar, w.ctx_.body_drifted, [&ar](char& x) {
+    auto v = static_cast<std::uint8_t>(x);
+    ar(v);
+    x = static_cast<char>(v);
+  });
 }
 
 }  // namespace

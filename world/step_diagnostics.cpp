@@ -203,14 +203,19 @@ void watchFastBodies(WorldImpl& w, StepContext& ctx) {
     const Aabb path{from.cwiseMin(to), from.cwiseMax(to)};
     std::int32_t passed = -1;
     Real passed_thickness = 0;
+    // Every candidate is visited and the lowest body index kept: the
+    // tree's shape (which a restored snapshot rebuilds differently) must
+    // not decide which body the report names.
     w.broadphase_.query(path, [&](int proxy) {
       const ShapeRef& ref = w.shapes_[static_cast<size_t>(w.broadphase_.user(proxy))];
       if (!ref.alive || ref.body.index == static_cast<std::int32_t>(i)) return true;
       const Real t = thickness(w.body(ref.body).shapes[static_cast<size_t>(ref.index)]);
       if (!(travel > own + t)) return true;
-      passed = ref.body.index;
-      passed_thickness = t;
-      return false;
+      if (passed < 0 || ref.body.index < passed) {
+        passed = ref.body.index;
+        passed_thickness = t;
+      }
+      return true;
     });
     if (passed < 0) continue;
     w.diagnose(static_cast<std::int32_t>(i), "fast body without CCD",

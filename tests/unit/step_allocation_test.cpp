@@ -12,10 +12,20 @@
 #include <cstdlib>
 #include <new>
 
+// Under AddressSanitizer the allocator is ASan's (it pairs every new with
+// its delete, which a partial replacement here would break): the count is
+// taken in the ordinary builds only, and the tests skip themselves there.
+#if defined(__SANITIZE_ADDRESS__)
+#define CAIRN_COUNT_ALLOCATIONS 0
+#else
+#define CAIRN_COUNT_ALLOCATIONS 1
+#endif
+
 namespace {
 std::atomic<long> g_allocations{0};
 }
 
+#if CAIRN_COUNT_ALLOCATIONS
 // The replacements pair malloc with free by construction; GCC, inlining
 // them into a caller's new/delete, cannot see that and would warn.
 #if defined(__GNUC__) && !defined(__clang__)
@@ -32,12 +42,14 @@ void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#endif
 
 namespace cairn {
 namespace {
 
 // Allocations made by `steps` steps after `warmup` steps of the scene.
 long allocationsAfterWarmUp(SceneDesc s, int warmup, int steps) {
+  if (!CAIRN_COUNT_ALLOCATIONS) return 0;
   s.solver.sleeping = false;
   World w = buildWorld(s);
   for (int k = 0; k < warmup; ++k) w.step(s.dt);
@@ -49,6 +61,7 @@ long allocationsAfterWarmUp(SceneDesc s, int warmup, int steps) {
 // A resting pyramid keeps its contact set: after the first second every
 // array has reached its size.
 TEST(StepAllocations, RestingPyramidAllocatesNothingAfterWarmUp) {
+  if (!CAIRN_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocations are ASan's in this build";
   EXPECT_EQ(allocationsAfterWarmUp(scenarios::pyramid(10), 60, 60), 0);
 }
 
@@ -56,6 +69,7 @@ TEST(StepAllocations, RestingPyramidAllocatesNothingAfterWarmUp) {
 // (A hanging chain: a chain that whips open under PGS is reported by a
 // joint-drift diagnostic each step, whose message is a new string.)
 TEST(StepAllocations, HangingChainAllocatesNothingAfterWarmUp) {
+  if (!CAIRN_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocations are ASan's in this build";
   EXPECT_EQ(allocationsAfterWarmUp(scenarios::hangingChain(20), 60, 60), 0);
 }
 

@@ -158,24 +158,26 @@ void watchJoints(WorldImpl& w) {
   }
 }
 
-void watchPenetration(WorldImpl& w) {
+// Returns the deepest overlap of any contact (StepStats::max_penetration):
+// one pass over the contacts serves the statistic and the watcher.
+Real watchPenetration(WorldImpl& w) {
   const SolverSettings& s = w.settings_;
   const Real tolerance = s.slop + s.penetration_drift;
+  Real deepest = 0;
   for (const Contact& c : w.contacts_) {
     if (!c.enabled) continue;
+    const Real depth = w.contactDepth(c);
+    deepest = std::max(deepest, depth);
+    if (!(depth > tolerance)) continue;
     const BodyId dyn = !c.body_b.isWorld() && w.body(c.body_b).isDynamic() ? c.body_b : c.body_a;
     if (dyn.isWorld() || !w.body(dyn).isDynamic() || w.body(dyn).asleep) continue;
-    const BodyView a = w.view(c.body_a), b = w.view(c.body_b);
-    Real depth = 0;
-    for (int i = 0; i < c.count; ++i)
-      depth = std::max(depth, -(worldPoint(b, c.points[i].local_b) - worldPoint(a, c.points[i].local_a)).dot(c.normal));
-    if (!(depth > tolerance)) continue;
     const BodyId other = dyn.index == c.body_a.index ? c.body_b : c.body_a;
     w.diagnose(dyn.index, "penetration",
                "penetrates '" + (other.isWorld() ? std::string("world") : w.body(other).name) + "' by " + fmt(depth) +
                    " m (slop " + fmt(s.slop) + " + penetration_drift " + fmt(s.penetration_drift) +
                    " m): a hard impact, a stack sinking or a contact not resolved; more iterations or substeps", true);
   }
+  return deepest;
 }
 
 // Thickness of a shape: the smallest extent of its own box (0 for a
@@ -257,7 +259,7 @@ void watchLimits(WorldImpl& w, StepContext& ctx) {
 void watchStep(WorldImpl& w, StepContext& ctx) {
   watchEnergy(w, ctx);
   watchJoints(w);
-  watchPenetration(w);
+  w.stats_.max_penetration = watchPenetration(w);
   watchFastBodies(w, ctx);
   watchLimits(w, ctx);
   w.external_forces_ = false;

@@ -166,6 +166,22 @@ std::string solveCulprit(const WorldImpl& w, const StepContext& ctx, std::int32_
 
 }  // namespace
 
+// A destroyed body's records go with it: its slot may be reused by a body
+// that must not inherit them, and a program that spawns and removes bodies
+// for hours must not collect a record for each.
+void WorldImpl::dropDiagnosticsOf(BodyId id) {
+  if (diagnostic_last_step_.size() < diagnostics_.size()) diagnostic_last_step_.resize(diagnostics_.size(), -1);
+  size_t kept = 0;
+  for (size_t i = 0; i < diagnostics_.size(); ++i) {
+    if (diagnostics_[i].body.index == id.index) continue;
+    diagnostics_[kept] = std::move(diagnostics_[i]);
+    diagnostic_last_step_[kept] = diagnostic_last_step_[i];
+    ++kept;
+  }
+  diagnostics_.resize(kept);
+  diagnostic_last_step_.resize(kept);
+}
+
 void WorldImpl::diagnose(std::int32_t body, const char* kind, const std::string& detail, bool once_per_step) {
   // A restored snapshot brings its diagnostics but not the step each was
   // last counted in.

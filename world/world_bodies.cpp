@@ -360,6 +360,7 @@ void WorldImpl::destroyBody(BodyId id) {
     if (!other.isWorld()) wakeBody(other);
   }
   dropContactsOf(id, -1);
+  dropDiagnosticsOf(id);
   Body& b = body(id);
   for (const std::int32_t slot : b.shape_ids) {
     ShapeRef& ref = shapes_[static_cast<size_t>(slot)];

@@ -87,15 +87,17 @@ bool WorldImpl::shouldCollide(const Body& a, const Body& b, BodyId ia, BodyId ib
   return true;
 }
 
-Real WorldImpl::maxPenetration() const {
-  Real worst = 0;
-  for (const Contact& c : contacts_) {
-    if (!c.enabled) continue;
-    const BodyView a = view(c.body_a), b = view(c.body_b);
-    for (int i = 0; i < c.count; ++i)
-      worst = std::max(worst, -(worldPoint(b, c.points[i].local_b) - worldPoint(a, c.points[i].local_a)).dot(c.normal));
-  }
-  return worst;
+Real WorldImpl::contactDepth(const Contact& c) const {
+  // The world body sits at the origin, unrotated: its local points are world points.
+  const auto point = [&](BodyId id, const Vec3& local) -> Vec3 {
+    if (id.isWorld()) return local;
+    const Body& b = bodies_[static_cast<size_t>(id.index)];
+    return b.position + b.orientation * local;
+  };
+  Real depth = 0;
+  for (int i = 0; i < c.count; ++i)
+    depth = std::max(depth, -(point(c.body_b, c.points[i].local_b) - point(c.body_a, c.points[i].local_a)).dot(c.normal));
+  return depth;
 }
 
 void collide(WorldImpl& w, StepContext& ctx) {

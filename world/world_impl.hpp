@@ -193,7 +193,8 @@ class WorldImpl {
   const std::vector<ShapeRef>& shapes() const { return shapes_; }
   const BroadPhase& broadPhase() const { return broadphase_; }
   BroadPhase& broadPhase() { return broadphase_; }
-  Real maxPenetration() const;
+  // Deepest overlap of a contact's points at the bodies' present poses (0 if none overlaps).
+  Real contactDepth(const Contact& c) const;
   BodyView view(BodyId id) const;
   BodyView view(int index) const;
   const StepContext& stepContext() const { return ctx_; }
@@ -293,6 +294,8 @@ class WorldImpl {
   std::vector<int> diagnostic_last_step_;  // per diagnostic: the last step it was counted in
   std::vector<JointBreakEvent> break_events_;
 
+  // Forgets a body's diagnostics (it is being destroyed).
+  void dropDiagnosticsOf(BodyId id);
   // Records a diagnostic on a body (index; -1: the world as a whole),
   // counted once per call, or once per step.
   void diagnose(std::int32_t body, const char* kind, const std::string& detail, bool once_per_step = false);

@@ -137,7 +137,6 @@ void WorldImpl::step(Real h) {
     stats_.contact_points += c.count;
   }
   stats_.islands = ctx.island_count;
-  stats_.max_penetration = maxPenetration();
   clock.lap(Stage::Guards);
   ++step_count_;
   time_ += h;

@@ -222,7 +222,8 @@ class World {
   /// Non-finite states caught and rolled back, since creation (never
   /// silently passed on).
   std::span<const NumericalEvent> numericalEvents() const;
-  /// Steps taken but not taken accurately, since creation.
+  /// Steps taken but not taken accurately, since creation: one record per
+  /// body and kind. Destroying a body drops its records.
   std::span<const Diagnostic> diagnostics() const;
 
   // --- Snapshots ------------------------------------------------------------------

@@ -88,6 +88,26 @@ TEST(StepDiagnostics, DeepPenetrationIsReported) {
   }
 }
 
+// A destroyed body's records go with it, and the body that takes its slot
+// starts clean: the deep box above is reported, destroyed, and a box created
+// resting on the ground (same slot, not penetrating) has no record. Without
+// this a program that spawns and removes bodies would keep a record for each.
+TEST(StepDiagnostics, DestroyingABodyDropsItsRecords) {
+  World w;
+  BodyDef g = test::boxDef("ground", Vec3(0, -0.5, 0), 1, Vec3(10, 0.5, 10));
+  g.type = BodyType::Static;
+  w.createBody(g);
+  const BodyId deep = w.createBody(test::boxDef("deep", Vec3(0, 0.2, 0)));
+  w.step(Real(1) / 60);
+  ASSERT_GT(count(w, "penetration"), 0);
+  w.destroyBody(deep);
+  for (const Diagnostic& d : w.diagnostics()) EXPECT_NE(d.body.index, deep.index) << d.kind;  // world-wide records stay
+  const BodyId fresh = w.createBody(test::boxDef("fresh", Vec3(0, 0.5, 0)));
+  EXPECT_EQ(fresh.index, deep.index);  // the slot is reused
+  for (int i = 0; i < 3; ++i) w.step(Real(1) / 60);
+  EXPECT_EQ(count(w, "penetration"), 0);
+}
+
 // A 5 cm sphere at 100 m/s toward a 1 cm wall, no gravity: 1.67 m a step,
 // far more than the sphere and the wall together; without CCD it passes
 // through and is reported, with CCD it is stopped and is not.

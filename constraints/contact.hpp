@@ -52,6 +52,12 @@ struct Contact {
   bool enabled = true;                      // a callback may veto
   bool touching = false;                    // some point within the margin this step
   bool began = false;                       // first step touching (for events)
+  // Where the narrowphase made this manifold, in A's frame (for recycling,
+  // world/world_contacts.cpp): B's offset R_a^T (x_b - x_a), B's rotation
+  // q_a^-1 q_b, and the normal R_a^T n.
+  Vec3 made_offset = Vec3::Zero();
+  Quat made_rotation = Quat::Identity();
+  Vec3 made_normal = Vec3::UnitY();
 
   std::uint64_t key() const {
     return (std::uint64_t(std::uint32_t(shape_a)) << 40) ^ (std::uint64_t(std::uint32_t(shape_b)) << 16) ^

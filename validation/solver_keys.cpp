@@ -29,6 +29,7 @@ constexpr Key kKeys[] = {
     {"warm_start", Type::Bool},   {"warm_start_factor", Type::Real}, {"randomize_order", Type::Bool},
     {"split_impulse", Type::Bool}, {"slop", Type::Real},        {"nncg", Type::Bool},
     {"sleeping", Type::Bool},     {"geometric_stiffness", Type::Bool}, {"position_iterations", Type::Int},
+    {"recycle_distance", Type::Real}, {"recycle_angle", Type::Real},
 };
 
 const Key* findKey(const std::string& name) {
@@ -136,6 +137,8 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
       else if (key == "sor") s.sor = v;
       else if (key == "tolerance") s.tolerance = v;
       else if (key == "warm_start_factor") s.warm_start_factor = v;
+      else if (key == "recycle_distance") s.recycle_distance = v;
+      else if (key == "recycle_angle") s.recycle_angle = v;
       else s.slop = v;
       break;
     }
@@ -168,6 +171,8 @@ std::string solverKeyValue(const SceneDesc& scene, const std::string& key) {
   if (key == "sleeping") return s.sleeping ? "true" : "false";
   if (key == "geometric_stiffness") return s.geometric_stiffness ? "true" : "false";
   if (key == "position_iterations") return std::to_string(s.position_iterations);
+  if (key == "recycle_distance") return exactNumberText(s.recycle_distance);
+  if (key == "recycle_angle") return exactNumberText(s.recycle_angle);
   throw InputError("solver", key, "unknown setting");
 }
 

@@ -208,6 +208,8 @@ void checkSolverSettings(const SolverSettings& s, const InputLimits& limits) {
                              std::pair{s.restitution_threshold, "restitution_threshold"},
                              std::pair{s.max_correction_velocity, "max_correction_velocity"},
                              std::pair{s.contact_margin, "contact_margin"},
+                             std::pair{s.recycle_distance, "recycle_distance"},
+                             std::pair{s.recycle_angle, "recycle_angle"},
                              std::pair{s.sleep_linear_velocity, "sleep_linear_velocity"},
                              std::pair{s.sleep_angular_velocity, "sleep_angular_velocity"},
                              std::pair{s.sleep_time, "sleep_time"}})

@@ -512,6 +512,8 @@ SolverSettings parseSolver(const json& j) {
   }
   s.max_correction_velocity = r.number("max_correction_velocity", s.max_correction_velocity);
   s.contact_margin = r.number("contact_margin", s.contact_margin);
+  s.recycle_distance = r.number("recycle_distance", s.recycle_distance);
+  s.recycle_angle = r.number("recycle_angle", s.recycle_angle);
   s.sleeping = r.boolean("sleeping", s.sleeping);
   s.sleep_linear_velocity = r.number("sleep_linear_velocity", s.sleep_linear_velocity);
   s.sleep_angular_velocity = r.number("sleep_angular_velocity", s.sleep_angular_velocity);

@@ -35,13 +35,13 @@ namespace {
 
 // A new field changes these sizes (x86-64, libstdc++): the compiler then
 // points here, to add it below and bump kSnapshotVersion.
-static_assert(sizeof(SolverSettings) == 240, "SolverSettings changed: update snapshot_state.cpp");
+static_assert(sizeof(SolverSettings) == 256, "SolverSettings changed: update snapshot_state.cpp");
 static_assert(sizeof(Body) == 960, "Body changed: update snapshot_state.cpp");
 static_assert(sizeof(ShapeDesc) == 208, "ShapeDesc changed: update snapshot_state.cpp");
 static_assert(sizeof(Joint) == 3456, "Joint changed: update snapshot_state.cpp");
 static_assert(sizeof(Spring) == 192, "Spring changed: update snapshot_state.cpp");
 static_assert(sizeof(ShapeRef) == 24, "ShapeRef changed: update snapshot_state.cpp");
-static_assert(sizeof(Contact) == 608, "Contact changed: update snapshot_state.cpp");
+static_assert(sizeof(Contact) == 704, "Contact changed: update snapshot_state.cpp");
 static_assert(sizeof(ContactPointState) == 120, "ContactPointState changed: update snapshot_state.cpp");
 
 // Hulls and meshes are shared between shapes; each is written once and the
@@ -101,6 +101,8 @@ void io(Ar& ar, SolverSettings& s) {
   ar(s.split_impulse);
   ar(s.max_correction_velocity);
   ar(s.contact_margin);
+  ar(s.recycle_distance);
+  ar(s.recycle_angle);
   ar(s.sleeping);
   ar(s.sleep_linear_velocity);
   ar(s.sleep_angular_velocity);
@@ -433,6 +435,9 @@ void io(Ar& ar, Contact& c) {
   ar(c.enabled);
   ar(c.touching);
   ar(c.began);
+  io(ar, c.made_offset);
+  io(ar, c.made_rotation);
+  io(ar, c.made_normal);
 }
 
 template <class Ar>

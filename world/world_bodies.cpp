@@ -127,6 +127,8 @@ void validateSettings(const SolverSettings& s) {
   if (!(s.max_correction_velocity > 0)) throw InputError(o, "max_correction_velocity", "must be positive");
   if (!(s.max_angular_velocity > 0)) throw InputError(o, "max_angular_velocity", "must be positive");
   requireNonNegative(o, "contact_margin", s.contact_margin);
+  requireNonNegative(o, "recycle_distance", s.recycle_distance);
+  requireNonNegative(o, "recycle_angle", s.recycle_angle);
   requireNonNegative(o, "sleep_linear_velocity", s.sleep_linear_velocity);
   requireNonNegative(o, "sleep_angular_velocity", s.sleep_angular_velocity);
   requireNonNegative(o, "sleep_time", s.sleep_time);

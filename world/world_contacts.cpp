@@ -25,6 +25,64 @@ Real reach(const Body& b, Real margin, Real h) {
   return b.ccd ? margin + h * b.linear_velocity.norm() : margin;
 }
 
+// The pair's friction and restitution: the bodies' combined (geometric
+// mean of the frictions, the larger restitution, Bullet's and Box2D's
+// rules), or the pair's own material if one was set.
+void combineMaterials(const WorldImpl& w, const Body& ba, const Body& bb, Contact& c) {
+  c.friction = std::sqrt(ba.friction * bb.friction);
+  c.restitution = std::max(ba.restitution, bb.restitution);
+  c.rolling_friction = std::max(ba.rolling_friction, bb.rolling_friction);
+  c.torsional_friction = std::max(ba.torsional_friction, bb.torsional_friction);
+  const std::uint64_t pk = bodyPairKey(c.body_a, c.body_b);
+  const auto mat = std::lower_bound(w.pair_materials_.begin(), w.pair_materials_.end(), pk,
+                                    [](const WorldImpl::PairMaterial& x, std::uint64_t k) { return x.key < k; });
+  if (mat != w.pair_materials_.end() && mat->key == pk) {
+    c.friction = mat->friction;
+    c.restitution = mat->restitution;
+  }
+}
+
+// Contact recycling, after Jolt's body pair cache (PhysicsSettings::
+// mBodyPairCacheMaxDeltaPositionSq and mBodyPairCacheCosMaxDeltaRotationDiv2).
+// A manifold's points are fixed on the two bodies, so while B has moved less
+// than recycle_distance and turned less than recycle_angle relative to A
+// since the narrowphase made the manifold, those points still describe the
+// contact: the manifold is kept and what depends on the present poses
+// (normal, depths, approach speeds) recomputed. The bounds are measured from
+// where the manifold was made, not from the last step, so slow drift cannot
+// add up past them. Only a pair that made exactly one convex manifold (no
+// mesh triangles) is recycled. Returns whether `out` got the recycled contact.
+bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::int32_t sa, std::int32_t sb,
+                     const std::vector<Contact>::const_iterator first, const std::vector<Contact>& old,
+                     std::vector<Contact>& out) {
+  const SolverSettings& s = w.settings_;
+  if (!(s.recycle_distance > 0) || !(s.recycle_angle > 0)) return false;
+  if (first == old.end() || first->shape_a != sa || first->shape_b != sb) return false;
+  const Contact& o = *first;
+  const auto next = first + 1;
+  if (o.triangle != -1 || o.count == 0 || !o.touching || (next != old.end() && next->shape_a == sa && next->shape_b == sb))
+    return false;
+  const Quat qa_inv = ba.orientation.conjugate();
+  const Vec3 offset = qa_inv * (bb.position - ba.position);
+  if ((offset - o.made_offset).squaredNorm() > s.recycle_distance * s.recycle_distance) return false;
+  // The angle between two rotations: |q1 . q2| = cos(angle / 2).
+  const Quat rotation = qa_inv * bb.orientation;
+  if (std::abs(rotation.coeffs().dot(o.made_rotation.coeffs())) < std::cos(s.recycle_angle / 2)) return false;
+  Contact c = o;
+  c.enabled = true;  // the callback decides again
+  c.normal = ba.orientation * o.made_normal;
+  combineMaterials(w, ba, bb, c);
+  const Transform ta = ba.transform(), tb = bb.transform();
+  for (int i = 0; i < c.count; ++i) {
+    ContactPointState& p = c.points[i];
+    const Vec3 on_a = ta.apply(p.local_a), on_b = tb.apply(p.local_b);
+    p.depth = (on_a - on_b).dot(c.normal);
+    p.approach_speed = c.normal.dot(bb.velocityAt(on_b) - ba.velocityAt(on_a));
+  }
+  out.push_back(c);
+  return true;
+}
+
 }  // namespace
 
 void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
@@ -126,17 +184,23 @@ void collide(WorldImpl& w, StepContext& ctx) {
     const Body& ba = body(ra.body);
     const Body& bb = body(rb.body);
     if (!w.shouldCollide(ba, bb, ra.body, rb.body)) continue;
+    // Last step's contacts of this pair. They are sorted by key, whose high
+    // bits are the two shapes: a binary search.
+    Contact probe;
+    probe.shape_a = sa;
+    probe.shape_b = sb;
+    probe.triangle = -1;
+    const auto cached = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), probe.key(),
+                                         [](const Contact& x, std::uint64_t k) { return x.key() < k; });
     const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
     if (a_still && b_still && (ba.asleep || bb.asleep)) {
-      // Nothing here moves: keep the cached contacts as they were. They are
-      // sorted by key, whose high bits are the two shapes: a binary search.
-      Contact probe;
-      probe.shape_a = sa;
-      probe.shape_b = sb;
-      probe.triangle = -1;
-      auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), probe.key(),
-                                 [](const Contact& x, std::uint64_t k) { return x.key() < k; });
-      for (; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it) contacts_.push_back(*it);
+      // Nothing here moves: keep the cached contacts as they were.
+      for (auto it = cached; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it)
+        contacts_.push_back(*it);
+      continue;
+    }
+    if (recycleManifold(w, ba, bb, sa, sb, cached, old_contacts_, contacts_)) {
+      ++w.stats_.recycled_contacts;
       continue;
     }
     const ShapeDesc& sda = ba.shapes[static_cast<size_t>(ra.index)];
@@ -155,17 +219,11 @@ void collide(WorldImpl& w, StepContext& ctx) {
       c.body_b = rb.body;
       c.normal = m.normal;
       c.count = m.count;
-      c.friction = std::sqrt(ba.friction * bb.friction);
-      c.restitution = std::max(ba.restitution, bb.restitution);
-      c.rolling_friction = std::max(ba.rolling_friction, bb.rolling_friction);
-      c.torsional_friction = std::max(ba.torsional_friction, bb.torsional_friction);
-      const std::uint64_t pk = bodyPairKey(ra.body, rb.body);
-      const auto mat = std::lower_bound(w.pair_materials_.begin(), w.pair_materials_.end(), pk,
-                                        [](const WorldImpl::PairMaterial& x, std::uint64_t k) { return x.key < k; });
-      if (mat != w.pair_materials_.end() && mat->key == pk) {
-        c.friction = mat->friction;
-        c.restitution = mat->restitution;
-      }
+      combineMaterials(w, ba, bb, c);
+      const Quat qa_inv = ba.orientation.conjugate();
+      c.made_offset = qa_inv * (bb.position - ba.position);
+      c.made_rotation = qa_inv * bb.orientation;
+      c.made_normal = qa_inv * m.normal;
       const Transform ta = ba.transform(), tb = bb.transform();
       for (int i = 0; i < m.count; ++i) {
         ContactPointState& p = c.points[i];

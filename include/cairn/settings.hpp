@@ -96,6 +96,14 @@ struct SolverSettings {
   Real max_correction_velocity = Real(10);  ///< m/s, clamp on ERP push-out
 
   Real contact_margin = Real(0.02);  ///< m: contacts are made this far before touching (speculative)
+  /// Contact recycling (Jolt's body pair cache): while a pair's relative
+  /// pose stays within recycle_distance (m) and recycle_angle (rad) of the
+  /// pose its manifold was made at, the manifold is kept (its points are
+  /// fixed on the bodies; normal, depths and approach speeds follow the
+  /// present poses) and the narrowphase is not run. 0 for either: the
+  /// narrowphase runs every step. docs/collision.md measures the trade.
+  Real recycle_distance = Real(0.001);
+  Real recycle_angle = Real(0.0349);  ///< 2 degrees
 
   /// Sleeping: an island whose bodies all stay below both speeds for
   /// sleep_time seconds sleeps and costs nothing until woken.

@@ -60,6 +60,7 @@ struct StepStats {
   int rows = 0;              ///< rows solved (last substep)
   int contacts = 0;          ///< touching manifolds
   int contact_points = 0;    ///< points of the touching manifolds
+  int recycled_contacts = 0; ///< manifolds kept without a narrowphase run (SolverSettings::recycle_distance)
   int islands = 0;           ///< awake islands solved
   int sleeping_bodies = 0;   ///< bodies asleep after the step
   double max_penetration = 0;  ///< deepest contact after the step (m)

@@ -435,6 +435,7 @@ void io(Ar& ar, Contact& c) {
   ar(c.enabled);
   ar(c.touching);
   ar(c.began);
+  ar(c.depth_after);
   io(ar, c.made_offset);
   io(ar, c.made_rotation);
   io(ar, c.made_normal);
@@ -498,6 +499,7 @@ void io(Ar& ar, StepContext::SavedState& s) {
   io(ar, s.q);
   io(ar, s.v);
   io(ar, s.w);
+  ar(s.asleep);
 }
 
 template <class Ar>

@@ -76,23 +76,36 @@ Real springEnergyAt(const WorldImpl& w, const Spring& s, const StepContext* star
                       s.def.stiffness);
 }
 
-// T + V at the step's start (from ctx.step_start) or now.
-Real energy(const WorldImpl& w, const StepContext* start) {
+// Whether a body cannot have moved in this step: asleep when it began and
+// still asleep, or static (kinematic bodies move).
+bool stillThroughStep(const WorldImpl& w, const StepContext& ctx, BodyId id) {
+  if (id.isWorld()) return true;
+  const Body& b = w.body(id);
+  if (b.type == BodyType::Static) return true;
+  return b.isDynamic() && b.asleep && ctx.step_start[static_cast<size_t>(id.index)].asleep;
+}
+
+// T + V at the step's start (from ctx.step_start) or now, of the bodies that
+// may have moved in the step (`moved`), or of those that cannot have
+// (`!moved`: the same at both ends, so left out of the step's change).
+Real energy(const WorldImpl& w, const StepContext& ctx, bool at_start, bool moved) {
   Real e = 0;
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
     const Body& b = w.bodies_[i];
     if (!b.alive || !b.isDynamic()) continue;
-    if (!start) {
+    if (stillThroughStep(w, ctx, w.bodyId(static_cast<int>(i))) == moved) continue;
+    if (!at_start) {
       e += b.kineticEnergy() - b.mass * w.gravity_.dot(b.position);
       continue;
     }
-    const StepContext::SavedState& st = start->step_start[i];
+    const StepContext::SavedState& st = ctx.step_start[i];
     const Mat3 r = st.q.toRotationMatrix();
     e += Real(0.5) * b.mass * st.v.squaredNorm() + Real(0.5) * st.w.dot(r * (b.inertia_body * (r.transpose() * st.w))) -
          b.mass * w.gravity_.dot(st.x);
   }
-  for (const Spring& s : w.springs_)
-    if (s.alive) e += springEnergyAt(w, s, start);
+  if (moved)
+    for (const Spring& s : w.springs_)
+      if (s.alive) e += springEnergyAt(w, s, at_start ? &ctx : nullptr);
   return e;
 }
 
@@ -114,9 +127,9 @@ bool externalWork(const WorldImpl& w, const StepContext& ctx) {
 }
 
 void watchEnergy(WorldImpl& w, StepContext& ctx) {
-  const Real before = energy(w, &ctx);
-  const Real after = energy(w, nullptr);
-  w.stats_.energy = after;
+  const Real before = energy(w, ctx, true, true);
+  const Real after = energy(w, ctx, false, true);
+  w.stats_.energy = after + energy(w, ctx, false, false);
   if (!std::isfinite(before) || !std::isfinite(after)) return;  // the guard reports non-finite states
   if (externalWork(w, ctx)) {
     w.energy_rise_ = 0;
@@ -159,14 +172,19 @@ void watchJoints(WorldImpl& w) {
 }
 
 // Returns the deepest overlap of any contact (StepStats::max_penetration):
-// one pass over the contacts serves the statistic and the watcher.
-Real watchPenetration(WorldImpl& w) {
+// one pass over the contacts serves the statistic and the watcher. A
+// contact whose bodies cannot have moved keeps the depth it had.
+Real watchPenetration(WorldImpl& w, const StepContext& ctx) {
   const SolverSettings& s = w.settings_;
   const Real tolerance = s.slop + s.penetration_drift;
   Real deepest = 0;
-  for (const Contact& c : w.contacts_) {
+  for (Contact& c : w.contacts_) {
     if (!c.enabled) continue;
-    const Real depth = w.contactDepth(c);
+    if (stillThroughStep(w, ctx, c.body_a) && stillThroughStep(w, ctx, c.body_b)) {
+      deepest = std::max(deepest, c.depth_after);
+      continue;
+    }
+    const Real depth = c.depth_after = w.contactDepth(c);
     deepest = std::max(deepest, depth);
     if (!(depth > tolerance)) continue;
     const BodyId dyn = !c.body_b.isWorld() && w.body(c.body_b).isDynamic() ? c.body_b : c.body_a;
@@ -259,7 +277,7 @@ void watchLimits(WorldImpl& w, StepContext& ctx) {
 void watchStep(WorldImpl& w, StepContext& ctx) {
   watchEnergy(w, ctx);
   watchJoints(w);
-  w.stats_.max_penetration = watchPenetration(w);
+  w.stats_.max_penetration = watchPenetration(w, ctx);
   watchFastBodies(w, ctx);
   watchLimits(w, ctx);
   w.external_forces_ = false;

@@ -206,7 +206,7 @@ void saveStepStart(WorldImpl& w, StepContext& ctx) {
     Body& b = w.bodies_[i];
     if (!b.alive) continue;
     if (finiteState(b)) {
-      ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity};
+      ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity, b.asleep};
       continue;
     }
     // Set through the API since the last step: back to the last good state.
@@ -221,7 +221,7 @@ void saveStepStart(WorldImpl& w, StepContext& ctx) {
 void saveStepEnd(WorldImpl& w, StepContext& ctx) {
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
     const Body& b = w.bodies_[i];
-    if (b.alive) ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity};
+    if (b.alive) ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity, b.asleep};
   }
 }
 

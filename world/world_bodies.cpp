@@ -327,7 +327,7 @@ BodyId WorldImpl::createBody(const BodyDef& def) {
   ++alive_bodies_;
   Body& nb = bodies_[static_cast<size_t>(index)];
   sleep_island_[static_cast<size_t>(index)] = -1;
-  ctx_.step_start[static_cast<size_t>(index)] = {nb.position, nb.orientation, nb.linear_velocity, nb.angular_velocity};
+  ctx_.step_start[static_cast<size_t>(index)] = {nb.position, nb.orientation, nb.linear_velocity, nb.angular_velocity, nb.asleep};
   const BodyId id{index, nb.generation};
   nb.shape_ids.assign(nb.shapes.size(), -1);
   for (size_t i = 0; i < nb.shapes.size(); ++i) registerShape(id, static_cast<std::int32_t>(i));

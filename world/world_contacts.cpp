@@ -327,11 +327,12 @@ void emitContactEvents(WorldImpl& w, StepContext&) {
     e.impulse = c.totalNormalImpulse();
     contact_events_.push_back(e);
   }
+  // Both lists are sorted by key (collide sorts them): one merge walk
+  // finds last step's contacts that are gone.
+  auto now = contacts_.begin();
   for (const Contact& o : old) {
-    if (!o.touching || !o.enabled) continue;
-    const auto it = std::lower_bound(contacts_.begin(), contacts_.end(), o.key(),
-                                     [](const Contact& x, std::uint64_t k) { return x.key() < k; });
-    if (it != contacts_.end() && it->key() == o.key()) continue;
+    while (now != contacts_.end() && now->key() < o.key()) ++now;
+    if (!o.touching || !o.enabled || (now != contacts_.end() && now->key() == o.key())) continue;
     contact_events_.push_back(event(o, ContactEvent::Type::End));
   }
   for (const Contact& o : w.ended_contacts_)

@@ -127,6 +127,7 @@ struct StepContext {
     Quat q;
     Vec3 v;
     Vec3 w;
+    bool asleep = false;  // asleep when the step began (the watchers skip what cannot have moved)
   };
   std::vector<SavedState> step_start;  // per body slot: the last good state
   std::vector<char> frozen_island;

@@ -176,13 +176,18 @@ class LargeReplay(unittest.TestCase):
                 page = open_page(browser, path)
                 load_ms = page.evaluate("cairnViewer.loadMilliseconds")
                 self.assertEqual(page.evaluate("cairnViewer.drawnInstances()"), 1001)
+                before = browser.cpu_seconds()
                 frames = page.evaluate("cairnViewer.measureFrames(5000)", timeout=60)
+                after = browser.cpu_seconds()
+                cpu = {k: 1000 * (after[k] - before.get(k, 0)) / max(1, frames["frames"]) for k in after}
                 with open("/proc/loadavg") as f:
                     load_average = f.read().split()[0]
                 print("load %.0f ms (navigation start to first frame drawn); playing: %.1f frames/s, "
                       "mean frame %.1f ms, 95th percentile %.1f ms over %d frames; page script %.2f ms per frame; "
+                      "CPU per frame: GPU process %.1f ms, page (renderer) %.1f ms, browser %.1f ms; "
                       "machine load average %s" % (load_ms, frames["fps"], frames["meanMs"], frames["p95Ms"],
-                                                   frames["frames"], frames["scriptMs"], load_average))
+                                                   frames["frames"], frames["scriptMs"], cpu.get("gpu-process", 0),
+                                                   cpu.get("renderer", 0), cpu.get("browser", 0), load_average))
                 self.assertEqual(page.errors, [])
                 # Generous bounds for a shared 2-core machine: Chromium draws
                 # with SwiftShader (software WebGL), whose speed depends on

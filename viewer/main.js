@@ -48,6 +48,9 @@ var CairnViewer = CairnViewer || {};
     this.renderer = new THREE.WebGLRenderer({ antialias: replay.shapeCount < 300 });
     this.renderer.setPixelRatio(window.devicePixelRatio || 1);
     this.renderer.setClearColor(0x20242a);
+    // The shape batches keep their poses in a float texture (shapes.js).
+    if (!this.renderer.capabilities.floatVertexTextures)
+      throw new Error('this browser\'s WebGL cannot read float textures in vertex shaders, which the viewer draws with');
     document.getElementById('view').appendChild(this.renderer.domElement);
     this.scene = new THREE.Scene();
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x404048, 0.65));

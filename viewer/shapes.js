@@ -1,9 +1,21 @@
-// Every shape drawn as itself, one THREE.InstancedMesh per geometry:
-// boxes, spheres and cylinders share a unit geometry scaled per instance
-// (so a 1,000-box pile is one draw call); capsules share one geometry per
-// (radius, half height); each convex hull and triangle mesh has its own;
-// planes are large squares. An instance's matrix is the body's pose (center
-// of mass) times the shape's pose in the body times the scale.
+// Every shape drawn as itself, one batch per geometry: boxes, spheres and
+// cylinders share a unit geometry scaled per instance (so a 1,000-box pile
+// is one draw call); capsules share one geometry per (radius, half height);
+// each convex hull and triangle mesh has its own; planes are large squares.
+// An instance's matrix is the body's pose (center of mass) times the
+// shape's pose in the body times the scale.
+//
+// Why batches and not THREE.InstancedMesh: Chromium without a GPU (headless,
+// as the browser tests run it) draws WebGL with SwiftShader, whose Vulkan
+// draw command runs one whole draw per instance (vk::CommandBuffer's
+// CmdDrawBase::draw loops over the instances, calling Renderer::draw for
+// each), about 0.1 ms apiece: 1,001 instanced boxes cost 110 ms a frame.
+// A batch is the geometry repeated once per instance, each vertex carrying
+// its instance's index; the instances' matrices and colours live in a float
+// texture the vertex shader reads (four RGBA texels an instance: the three
+// rows of the affine matrix, then the colour). It draws as one plain draw
+// call on any WebGL, and a frame changes only the texture, 64 bytes an
+// instance, uploaded when the shown frame changes.
 'use strict';
 var CairnViewer = CairnViewer || {};
 
@@ -94,7 +106,80 @@ var CairnViewer = CairnViewer || {};
     };
   }
 
-  // The instanced meshes of one engine's bodies. options: wireframe (Bullet's
+  // Texels of an instance in the instance texture, and instances per texture
+  // row: a power of two, so the shader's t / width is exact in float.
+  const TEXELS = 4, PER_ROW = 256, WIDTH = TEXELS * PER_ROW;
+
+  // The vertex shader's instance matrix and colour, read from the texture
+  // (three.js's chunks apply `instanceMatrix` under USE_INSTANCING, defined
+  // here after the program's prefix, so no instanced attribute is declared).
+  const INSTANCE_DECLARATIONS = [
+    'uniform sampler2D instanceData;',
+    'uniform vec2 instanceDataSize;',
+    'attribute float instanceIndex;',
+    'vec4 instanceTexel(float k) {',
+    '  float t = ' + TEXELS + '.0 * instanceIndex + k, row = floor(t / instanceDataSize.x);',
+    '  return texture2D(instanceData, (vec2(t - row * instanceDataSize.x, row) + 0.5) / instanceDataSize);',
+    '}',
+    '#define USE_INSTANCING',
+  ].join('\n');
+  const INSTANCE_MAIN = [
+    'void main() {',
+    '  vec4 r0 = instanceTexel(0.0), r1 = instanceTexel(1.0), r2 = instanceTexel(2.0);',
+    '  mat4 instanceMatrix = mat4(r0.x, r1.x, r2.x, 0.0, r0.y, r1.y, r2.y, 0.0,',
+    '                             r0.z, r1.z, r2.z, 0.0, r0.w, r1.w, r2.w, 1.0);',
+  ].join('\n');
+  const INSTANCE_COLOR = '#ifdef USE_COLOR\n  vColor.xyz = instanceTexel(3.0).rgb;\n#endif';
+
+  // Makes `material` read its instances from `texture` (one program for
+  // every batch: three.js keys programs by this function's text).
+  function readInstances(material, texture) {
+    material.onBeforeCompile = function (shader) {
+      shader.uniforms.instanceData = { value: this.userData.instanceData };
+      shader.uniforms.instanceDataSize = { value: this.userData.instanceDataSize };
+      shader.vertexShader = INSTANCE_DECLARATIONS + '\n' + shader.vertexShader
+        .replace('void main() {', INSTANCE_MAIN)
+        .replace('#include <color_vertex>', INSTANCE_COLOR);
+    };
+    material.userData.instanceData = texture;
+    material.userData.instanceDataSize = new THREE.Vector2(texture.image.width, texture.image.height);
+  }
+
+  // `base` repeated n times; instanceIndex says which copy a vertex is.
+  function batchGeometry(base, n) {
+    const g = new THREE.BufferGeometry(), v = base.getAttribute('position').count;
+    for (const name of ['position', 'normal']) {
+      const a = base.getAttribute(name).array, out = new Float32Array(a.length * n);
+      for (let i = 0; i < n; i++) out.set(a, i * a.length);
+      g.setAttribute(name, new THREE.BufferAttribute(out, 3));
+    }
+    const index = new Float32Array(v * n);
+    for (let i = 0; i < n; i++) index.fill(i, i * v, (i + 1) * v);
+    g.setAttribute('instanceIndex', new THREE.BufferAttribute(index, 1));
+    if (base.index) {
+      const a = base.index.array, out = new (v * n > 65535 ? Uint32Array : Uint16Array)(a.length * n);
+      for (let i = 0; i < n; i++) for (let j = 0; j < a.length; j++) out[i * a.length + j] = a[j] + i * v;
+      g.setIndex(new THREE.BufferAttribute(out, 1));
+    }
+    return g;
+  }
+
+  // Ray against each instance's own geometry, as THREE.InstancedMesh's
+  // raycast does: hits carry the instanceId.
+  const probe = new THREE.Mesh(), probeHits = [], instanceWorld = new THREE.Matrix4();
+  function raycastInstances(raycaster, intersects) {
+    probe.geometry = this.userData.base;
+    probe.material = this.material;
+    for (let i = 0; i < this.count; i++) {
+      instanceWorld.fromArray(this.userData.matrices, 16 * i).premultiply(this.matrixWorld);
+      probe.matrixWorld = instanceWorld;
+      probe.raycast(raycaster, probeHits);
+      for (const hit of probeHits) { hit.instanceId = i; hit.object = this; intersects.push(hit); }
+      probeHits.length = 0;
+    }
+  }
+
+  // The batches of one engine's bodies. options: wireframe (Bullet's
   // overlay), color (wireframe colour), bodies (which bodies to draw),
   // planeSize (m).
   V.ShapeLayer = function (replay, options) {
@@ -118,22 +203,19 @@ var CairnViewer = CairnViewer || {};
     this.meshes = [];
     for (const [key, group] of groups) {
       const n = group.instances.length;
-      let geometry = group.geometry, material;
-      if (options.wireframe) {
-        material = new THREE.MeshBasicMaterial({ color: options.color, wireframe: true, transparent: true, opacity: 0.8 });
-      } else {
-        // Per-instance colour: an instanced 'color' attribute read by the
-        // vertex-colour path of the material (r111 has no setColorAt).
-        geometry = geometry.clone();
-        geometry.setAttribute('color', new THREE.InstancedBufferAttribute(new Float32Array(3 * n), 3));
-        material = new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors,
+      const texture = new THREE.DataTexture(new Float32Array(4 * WIDTH * Math.ceil(n / PER_ROW)), WIDTH,
+        Math.ceil(n / PER_ROW), THREE.RGBAFormat, THREE.FloatType);
+      const material = options.wireframe
+        ? new THREE.MeshBasicMaterial({ color: options.color, wireframe: true, transparent: true, opacity: 0.8 })
+        : new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors,
           side: key === 'plane' || key.startsWith('mesh') ? THREE.DoubleSide : THREE.FrontSide });
-      }
-      const mesh = new THREE.InstancedMesh(geometry, material, n);
-      mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+      readInstances(material, texture);
+      const mesh = new THREE.Mesh(batchGeometry(group.geometry, n), material);
+      mesh.count = n;
+      mesh.raycast = raycastInstances;
       mesh.frustumCulled = false;  // the bounds are the unit geometry's, not the instances'
-      mesh.userData.instances = group.instances;
-      mesh.userData.kind = key.split(' ')[0];
+      mesh.userData = { base: group.geometry, instances: group.instances, kind: key.split(' ')[0],
+                        texture, matrices: new Float32Array(16 * n) };
       this.meshes.push(mesh);
     }
   };
@@ -144,25 +226,29 @@ var CairnViewer = CairnViewer || {};
   // Poses of `track` at frame f.
   V.ShapeLayer.prototype.update = function (track, f, bodyCount) {
     for (const mesh of this.meshes) {
-      const instances = mesh.userData.instances, out = mesh.instanceMatrix.array;
+      const { instances, matrices, texture } = mesh.userData, out = texture.image.data;
       for (let i = 0; i < instances.length; i++) {
         const k = f * bodyCount + instances[i].body;
         position.fromArray(track.position, 3 * k);
         quaternion.fromArray(track.orientation, 4 * k);
         bodyMatrix.compose(position, quaternion, one);
-        world.multiplyMatrices(bodyMatrix, instances[i].local).toArray(out, 16 * i);
+        world.multiplyMatrices(bodyMatrix, instances[i].local).toArray(matrices, 16 * i);
+        const e = world.elements, t = 4 * TEXELS * i;  // rows 0-2 of the column-major matrix
+        for (let r = 0; r < 3; r++) {
+          out[t + 4 * r] = e[r]; out[t + 4 * r + 1] = e[4 + r]; out[t + 4 * r + 2] = e[8 + r]; out[t + 4 * r + 3] = e[12 + r];
+        }
       }
-      mesh.instanceMatrix.needsUpdate = true;
+      texture.needsUpdate = true;
     }
   };
 
   // colorOf(body) -> THREE.Color, for every instance.
   V.ShapeLayer.prototype.paint = function (colorOf) {
     for (const mesh of this.meshes) {
-      const attribute = mesh.geometry.getAttribute('color');
-      if (!attribute) continue;
-      mesh.userData.instances.forEach((inst, i) => colorOf(inst.body).toArray(attribute.array, 3 * i));
-      attribute.needsUpdate = true;
+      if (!mesh.material.vertexColors) continue;
+      const { instances, texture } = mesh.userData;
+      instances.forEach((inst, i) => colorOf(inst.body).toArray(texture.image.data, 4 * TEXELS * i + 12));
+      texture.needsUpdate = true;
     }
   };
 

@@ -77,6 +77,36 @@ class Browser:
         os.close(self.read_fd)
         shutil.rmtree(self.profile, ignore_errors=True)
 
+    def cpu_seconds(self):
+        """CPU time (user + system, s) used so far by the browser's processes,
+        by kind: {'browser', 'gpu-process', 'renderer', 'utility', ...}
+        (each child's --type; /proc, Linux only)."""
+        tick = os.sysconf("SC_CLK_TCK")
+        children, out = {}, {}
+        for entry in os.listdir("/proc"):
+            if not entry.isdigit():
+                continue
+            try:
+                with open("/proc/%s/stat" % entry) as f:
+                    stat = f.read()
+                with open("/proc/%s/cmdline" % entry) as f:
+                    args = f.read().replace("\0", " ").split()  # Chromium rewrites its title: spaces
+            except OSError:
+                continue
+            fields = stat[stat.rindex(")") + 2:].split()  # after "pid (name) "
+            kind = next((a[len("--type="):] for a in args if a.startswith("--type=")), "browser")
+            children.setdefault(int(fields[1]), []).append((int(entry), kind, (int(fields[11]) + int(fields[12])) / tick))
+        stack = [self.process.pid]
+        with open("/proc/%d/stat" % self.process.pid) as f:
+            stat = f.read()
+        fields = stat[stat.rindex(")") + 2:].split()
+        out["browser"] = (int(fields[11]) + int(fields[12])) / tick
+        while stack:
+            for pid, kind, seconds in children.get(stack.pop(), []):
+                out[kind] = out.get(kind, 0) + seconds
+                stack.append(pid)
+        return out
+
     def _read_message(self, deadline):
         while b"\0" not in self.buffer:
             left = deadline - time.monotonic()

@@ -4,8 +4,9 @@ driven over its DevTools pipe (cdp.py). Run by ctest (label "browser"):
 
     viewer_test.py --cairn build/cairn            the default checks
     viewer_test.py --cairn build/cairn --large    a 1,000-body, 600-step
-        replay (scenes/pile-1000.json): load time and frame times, printed
-        and checked against generous bounds (ctest label "long")
+        replay (scenes/pile-1000.json): load time, frame times and the
+        browser's CPU time per frame by process, printed and checked against
+        what this machine reaches (ctest label "long")
 
 For each page: no console error or uncaught exception; the instances drawn
 equal the scene's shapes, kind by kind; the picture at t = 5 s differs from
@@ -176,19 +177,30 @@ class LargeReplay(unittest.TestCase):
                 page = open_page(browser, path)
                 load_ms = page.evaluate("cairnViewer.loadMilliseconds")
                 self.assertEqual(page.evaluate("cairnViewer.drawnInstances()"), 1001)
+                before = browser.cpu_seconds()
                 frames = page.evaluate("cairnViewer.measureFrames(5000)", timeout=60)
+                after = browser.cpu_seconds()
+                cpu = {k: 1000 * (after[k] - before.get(k, 0)) / max(1, frames["frames"]) for k in after}
                 with open("/proc/loadavg") as f:
                     load_average = f.read().split()[0]
                 print("load %.0f ms (navigation start to first frame drawn); playing: %.1f frames/s, "
                       "mean frame %.1f ms, 95th percentile %.1f ms over %d frames; page script %.2f ms per frame; "
+                      "CPU per frame: GPU process %.1f ms, page (renderer) %.1f ms, browser %.1f ms; "
                       "machine load average %s" % (load_ms, frames["fps"], frames["meanMs"], frames["p95Ms"],
-                                                   frames["frames"], frames["scriptMs"], load_average))
+                                                   frames["frames"], frames["scriptMs"], cpu.get("gpu-process", 0),
+                                                   cpu.get("renderer", 0), cpu.get("browser", 0), load_average))
                 self.assertEqual(page.errors, [])
-                # Generous bounds for a shared 2-core machine: Chromium draws
-                # with SwiftShader (software WebGL), whose speed depends on
-                # the machine's load; the page's own script must stay well
-                # inside a 60 Hz frame (16.7 ms).
-                self.assertLess(load_ms, 15000)
+                # What this machine reaches, with a margin for its load (docs/viewer.md,
+                # "Large runs"): headless Chromium draws WebGL with SwiftShader
+                # (software), and the pile's front faces cover 2.45 million
+                # pixels a frame at 1000 x 700, which SwiftShader rasterizes in
+                # about 55 ms of CPU: 15-22 frames/s at load average 3-4, 7.5-10
+                # at 5-6.6 on the 2 shared cores, so 60 frames/s (the target on
+                # a GPU) is not asserted here; the floor is 5. Loading took
+                # 1.2-2.7 s (3.7 s at load 6.7): under 6 s. The page's own
+                # script must stay well inside a 60 Hz frame (16.7 ms): it
+                # measured 1.0-2.9 ms.
+                self.assertLess(load_ms, 6000)
                 self.assertGreater(frames["fps"], 5)
                 self.assertLess(frames["scriptMs"], 8)
 

@@ -125,7 +125,9 @@ void WorldImpl::step(Real h) {
   updateSleep(*this, ctx);
   clock.lap(Stage::Sleep);
   watchStep(*this, ctx);  // diagnostics: what went wrong without a NaN
+  clock.lap(Stage::Guards);
   moveProxies(kWorldBody, h);  // fat boxes hold the shapes where they ended, for queries between steps
+  clock.lap(Stage::Collide);   // the broadphase's work, wherever in the step it happens
   for (Body& b : bodies_) {
     b.force.setZero();
     b.torque.setZero();

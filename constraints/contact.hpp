@@ -35,7 +35,7 @@ struct ContactPointState {
   Real max_impulse = 0;          // the largest normal impulse of this step's substeps (restitution acts only where > 0)
   Vec3 friction_impulse = Vec3::Zero();  // accumulated tangential impulse, world vector
   std::int32_t normal_row = -1;  // this (sub)step's row index
-  std::int32_t friction_row = -1;  // first of two
+  std::int32_t friction_row = -1;  // first of one or two (SolverSettings::friction_directions)
 };
 
 struct Contact {
@@ -81,6 +81,7 @@ struct ContactRowSettings {
   Correction correction = Correction::PseudoVelocity;
   bool warm_start = true;
   Real warm_start_factor = 1;
+  int friction_directions = 2;  // tangent rows per point (SolverSettings::friction_directions)
 };
 
 // Appends the normal rows of one contact, then (in a later call, once every

@@ -110,7 +110,7 @@ void buildContactFrictionRows(Contact& c, std::int32_t owner, const BodyView& a,
       else t1 = anyPerpendicular(n);
       const Vec3 t2 = n.cross(t1);
       p.friction_row = static_cast<std::int32_t>(rows.size());
-      for (int k = 0; k < 2; ++k) {
+      for (int k = 0; k < s.friction_directions; ++k) {
         const Vec3 t = k == 0 ? t1 : t2;
         ConstraintRow fr = makeRow(a, b, t, ra, rb, cfm, RowKind::ContactFriction, owner, 4 + 2 * i + k);
         fr.normal_row = p.normal_row - island_begin;
@@ -147,8 +147,9 @@ void storeContactImpulses(Contact& c, const std::vector<ConstraintRow>& rows) {
     p.normal_impulse = rows[static_cast<size_t>(p.normal_row)].lambda;
     p.friction_impulse.setZero();
     if (p.friction_row >= 0) {
-      for (int k = 0; k < 2; ++k) {
-        const ConstraintRow& fr = rows[static_cast<size_t>(p.friction_row + k)];
+      for (size_t r = static_cast<size_t>(p.friction_row); r < rows.size() && r < static_cast<size_t>(p.friction_row) + 2; ++r) {
+        const ConstraintRow& fr = rows[r];
+        if (fr.kind != RowKind::ContactFriction || fr.owner_row < 4 + 2 * i || fr.owner_row > 5 + 2 * i) break;
         p.friction_impulse += fr.j_lin_b * fr.lambda;
       }
     }

@@ -88,6 +88,7 @@ struct ContactSweepParams {
   double sor = 1;
   int dynamic_end = 1;  // solver bodies [1, dynamic_end) may be written; 0 (the world) and the rest are read only
   bool gather_change = false;  // NNCG: record each row's change and the lane's squared norm
+  int friction_rows = 2;       // tangent rows per point (SolverSettings::friction_directions)
   // Per island: 1 while its sweeps go on, 0 once it has stopped (its lanes
   // are left as they are). Null: every island goes on.
   const double* island_active = nullptr;

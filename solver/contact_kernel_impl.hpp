@@ -445,7 +445,7 @@ struct Kernel {
           ContactBatch::Point& q = b.p[i];
           const V3 t1 = ld3(q.t, o);
           const D limit = mu * ld(q.lambda + o);
-          for (int k = 0; k < 2; ++k) {
+          for (int k = 0; k < p.friction_rows; ++k) {
             const V3 u = k == 0 ? t1 : cross(n, t1);
             const V3 ra_u = ld3(q.rat[k], o), rb_u = ld3(q.rbt[k], o);
             const D l = ld(q.lambda_t[k] + o);

@@ -84,6 +84,7 @@ struct GraphSolveOptions {
   bool nncg = true;
   bool randomize_order = false;
   int dynamic_end = 1;  // solver bodies [1, dynamic_end) may be written (0 is the world)
+  int friction_rows = 2;  // tangent rows per contact point
   const ContactKernels* kernels = nullptr;
   WorkerPool* pool = nullptr;  // null: this thread only
 };

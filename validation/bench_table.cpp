@@ -16,11 +16,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// cairn's contact rows: a normal row and two friction rows per point
-// (constraints/contact.cpp, docs/contacts.md). Bullet's defaults solve one
+// cairn's contact rows: a normal row and SolverSettings::friction_directions
+// friction rows per point (2 unless set). Bullet's defaults solve one
 // friction row per point along the sliding direction; matched adds the
 // second (SOLVER_USE_2_FRICTION_DIRECTIONS, bullet_oracle.cpp).
-int frictionDirections(BenchEngine e) { return e == BenchEngine::BulletDefaults ? 1 : 2; }
+int frictionDirections(BenchEngine e, const SolverSettings& s) {
+  if (e == BenchEngine::Cairn) return s.friction_directions;
+  return e == BenchEngine::BulletDefaults ? 1 : 2;
+}
 
 std::string num(double v) { return std::isfinite(v) ? exactNumberText(v) : std::string(); }
 std::string num(const std::optional<double>& v) { return v ? num(*v) : std::string(); }
@@ -51,7 +54,7 @@ Settings settingsOf(const BenchScene& scene, BenchEngine e) {
     out.sleeping = v.sleeping ? "on: " + g("%g", v.sleep_linear_velocity) + " m/s, " + g("%g", v.sleep_angular_velocity) +
                                     " rad/s, " + g("%g", v.sleep_time) + " s"
                               : "off";
-  out.friction = std::to_string(frictionDirections(e));
+  out.friction = std::to_string(frictionDirections(e, v));
   out.threads = cairn ? std::to_string(v.threads) : "1";  // btDiscreteDynamicsWorld steps on one thread
   out.overrides = scene.overrides[size_t(e)];
   return out;

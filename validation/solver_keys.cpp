@@ -29,7 +29,7 @@ constexpr Key kKeys[] = {
     {"warm_start", Type::Bool},   {"warm_start_factor", Type::Real}, {"randomize_order", Type::Bool},
     {"split_impulse", Type::Bool}, {"slop", Type::Real},        {"nncg", Type::Bool},
     {"sleeping", Type::Bool},     {"geometric_stiffness", Type::Bool}, {"position_iterations", Type::Int},
-    {"recycle_distance", Type::Real}, {"recycle_angle", Type::Real},
+    {"recycle_distance", Type::Real}, {"recycle_angle", Type::Real}, {"friction_directions", Type::Int},
 };
 
 const Key* findKey(const std::string& name) {
@@ -108,6 +108,7 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
         bad(option, value, "is not an integer");
       if (key == "substeps") s.substeps = v;
       else if (key == "position_iterations") s.position_iterations = v;
+      else if (key == "friction_directions") s.friction_directions = v;
       else s.iterations = v;
       break;
     }
@@ -173,6 +174,7 @@ std::string solverKeyValue(const SceneDesc& scene, const std::string& key) {
   if (key == "position_iterations") return std::to_string(s.position_iterations);
   if (key == "recycle_distance") return exactNumberText(s.recycle_distance);
   if (key == "recycle_angle") return exactNumberText(s.recycle_angle);
+  if (key == "friction_directions") return std::to_string(s.friction_directions);
   throw InputError("solver", key, "unknown setting");
 }
 

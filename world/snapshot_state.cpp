@@ -35,7 +35,7 @@ namespace {
 
 // A new field changes these sizes (x86-64, libstdc++): the compiler then
 // points here, to add it below and bump kSnapshotVersion.
-static_assert(sizeof(SolverSettings) == 256, "SolverSettings changed: update snapshot_state.cpp");
+static_assert(sizeof(SolverSettings) == 264, "SolverSettings changed: update snapshot_state.cpp");
 static_assert(sizeof(Body) == 960, "Body changed: update snapshot_state.cpp");
 static_assert(sizeof(ShapeDesc) == 208, "ShapeDesc changed: update snapshot_state.cpp");
 static_assert(sizeof(Joint) == 3456, "Joint changed: update snapshot_state.cpp");
@@ -100,6 +100,7 @@ void io(Ar& ar, SolverSettings& s) {
   ar(s.restitution_threshold);
   ar(s.split_impulse);
   ar(s.max_correction_velocity);
+  ar(s.friction_directions);
   ar(s.contact_margin);
   ar(s.recycle_distance);
   ar(s.recycle_angle);

@@ -85,6 +85,7 @@ struct ContactParams {
   Real h = 0, cfm = 0, contact_erp = 0, slop = 0, threshold = 0, max_correction = 0, warm = 0;
   Correction correction = Correction::PseudoVelocity;
   bool first_substep = true;
+  int friction_rows = 2;
 };
 
 // One manifold into one lane (contact_batch.hpp lists the fields).
@@ -170,7 +171,9 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
     else t1 = anyPerpendicular(n);
     store3(q.t, lane, t1);
     if (c.friction > 0) {
-      for (int k2 = 0; k2 < 2; ++k2) {
+      // A tangent row left out keeps a zero effective mass: no row (the
+      // residual, the statistics and the exported rows skip it).
+      for (int k2 = 0; k2 < cp.friction_rows; ++k2) {
         const Vec3 t = k2 == 0 ? t1 : Vec3(n.cross(t1));
         const Vec3 rat = ra.cross(t), rbt = rb.cross(t);
         store3(q.rat[k2], lane, rat);
@@ -438,6 +441,7 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   cp.warm = s.warm_start ? s.warm_start_factor : Real(0);
   cp.correction = s.split_impulse ? Correction::PseudoVelocity : s.position_correction;
   cp.first_substep = first_substep;
+  cp.friction_rows = s.friction_directions;
   ContactRowSettings crs;
   crs.h = h;
   crs.contact_erp = s.contact_erp;
@@ -448,6 +452,7 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   crs.correction = cp.correction;
   crs.warm_start = s.warm_start;
   crs.warm_start_factor = s.warm_start_factor;
+  crs.friction_directions = s.friction_directions;
   const JointRowSettings jrs{s.restitution_threshold};
   const auto jointRows = [&](std::int32_t ji, std::vector<ConstraintRow>& rows, Correction correction) {
     const Joint& j = w.joints_[static_cast<size_t>(ji)];
@@ -542,7 +547,7 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   }
 
   // Rows by kind (statistics): a manifold's valid points are a normal row
-  // each and, with friction, two tangent rows.
+  // each and, with friction, one or two tangent rows.
   int* kinds = w.stats_.rows_by_kind;
   for (const ConstraintRow& r : g.rows) ++kinds[static_cast<int>(r.kind)];
   for (const ConstraintRow& r : ctx.rows) ++kinds[static_cast<int>(r.kind)];
@@ -551,7 +556,8 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
       for (int i = 0; i < b.count[l]; ++i)
         if (b.p[i].valid[l] > 0) {
           ++kinds[static_cast<int>(RowKind::ContactNormal)];
-          if (b.mu[l] > 0) kinds[static_cast<int>(RowKind::ContactFriction)] += 2;
+          if (b.mu[l] > 0)
+            for (int k = 0; k < 2; ++k) kinds[static_cast<int>(RowKind::ContactFriction)] += b.p[i].tangent_mass[k][l] > 0;
         }
   int total = 0;
   for (int k = 0; k < kRowKindCount; ++k) total += kinds[k];

@@ -19,6 +19,7 @@ GraphSolveOptions graphOptions(WorldImpl& w, const StepContext& ctx) {
   o.iterations = s.iterations;
   o.tolerance = s.tolerance;
   o.sor = s.sor;
+  o.friction_rows = s.friction_directions;
   o.nncg = s.nncg;
   o.randomize_order = s.randomize_order;
   o.dynamic_end = ctx.dynamic_count + 1;
@@ -78,6 +79,7 @@ Real manifoldResidual(const GraphProblem& g, std::span<const SolverBody> v) {
         if (b.mu[l] <= 0) continue;
         const Real bound = b.mu[l] * ln;
         for (int k = 0; k < 2; ++k) {
+          if (q.tangent_mass[k][l] == 0) continue;  // no such row
           const Real lt = q.lambda_t[k][l];
           const Real wt = jv(laneRowParts(b, l, i, 1 + k)) + cfm * lt;
           worst = std::max(worst, std::abs(lt - std::clamp(lt - wt, -bound, bound)));
@@ -335,6 +337,7 @@ std::vector<ConstraintRow> WorldImpl::expandedRows() const {
       for (int i = 0; i < kMaxPoints; ++i, ++point) {
         if (normal_at[point] < 0 || b.mu[l] <= 0) continue;
         for (int k = 0; k < 2; ++k) {
+          if (b.p[i].tangent_mass[k][l] == 0) continue;  // no such row
           ConstraintRow r = laneRow(b, l, i, 1 + k, b.p[i].tangent_mass[k][l], RowKind::ContactFriction);
           r.body_a = remap(b.body_a[l]);
           r.body_b = remap(b.body_b[l]);

@@ -127,6 +127,8 @@ void validateSettings(const SolverSettings& s) {
   if (!(s.max_correction_velocity > 0)) throw InputError(o, "max_correction_velocity", "must be positive");
   if (!(s.max_angular_velocity > 0)) throw InputError(o, "max_angular_velocity", "must be positive");
   requireNonNegative(o, "contact_margin", s.contact_margin);
+  if (s.friction_directions != 1 && s.friction_directions != 2)
+    throw InputError(o, "friction_directions", "must be 1 or 2 (got " + std::to_string(s.friction_directions) + ")");
   requireNonNegative(o, "recycle_distance", s.recycle_distance);
   requireNonNegative(o, "recycle_angle", s.recycle_angle);
   requireNonNegative(o, "sleep_linear_velocity", s.sleep_linear_velocity);

@@ -94,6 +94,13 @@ struct SolverSettings {
   Real restitution_threshold = Real(0.2); ///< m/s: slower approach does not bounce
   bool split_impulse = true;              ///< contacts: push out with pseudo-velocities (Bullet's split impulse)
   Real max_correction_velocity = Real(10);  ///< m/s, clamp on ERP push-out
+  /// Friction rows per contact point: 2, two tangents (a friction box,
+  /// isotropic to within the box's corners); 1, one tangent along the
+  /// sliding direction, or the carried friction impulse when at rest
+  /// (Bullet's default, without SOLVER_USE_2_FRICTION_DIRECTIONS): a third
+  /// fewer contact rows, and nothing resists a start of sliding across it
+  /// until the next step turns the tangent. docs/performance.md measures it.
+  int friction_directions = 2;
 
   Real contact_margin = Real(0.02);  ///< m: contacts are made this far before touching (speculative)
   /// Contact recycling (Jolt's body pair cache): while a pair's relative

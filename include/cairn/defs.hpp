@@ -163,9 +163,8 @@ const char* dofName(int dof);  ///< "translation_x" ... "rotation_z", as in scen
 /// The kinds of joint (docs/constraints.md).
 enum class JointType { Ball, Hinge, Slider, Fixed, Universal, ConeTwist, Distance, AngularMotor, SixDof };
 
-const char* jointTypeName(JointType t);
-
 const char* jointTypeName(JointType t);  ///< lower-case name, as in scene files
+
 /// A joint to create (World::createJoint); which fields count depends on its type.
 struct JointDef {
   std::string name;  ///< for messages and World::findJoint; may be empty

@@ -63,11 +63,12 @@ std::string csvRecord(const std::vector<std::string>& fields) {
   return r.line();
 }
 
-std::vector<std::vector<std::string>> parseCsv(std::string_view text, const std::string& source) {
-  std::vector<std::vector<std::string>> records;
-  std::vector<std::string> record;
+std::vector<CsvRow> parseCsvRows(std::string_view text, const std::string& source) {
+  std::vector<CsvRow> records;
+  CsvRow record;
   std::string field;
   size_t line = 1;
+  record.line = 1;
   const auto fail = [&](const std::string& why) { throw InputError(source + ":" + std::to_string(line), "", why); };
   size_t i = 0;
   const size_t n = text.size();
@@ -96,23 +97,32 @@ std::vector<std::vector<std::string>> parseCsv(std::string_view text, const std:
       }
       if (i < n && text[i] != ',' && text[i] != '\n' && text[i] != '\r') fail("text after a closing quote");
     } else {
-      while (i < n && text[i] != ',' && text[i] != '\n' && text[i] != '\r') field += text[i++];
+      while (i < n && text[i] != ',' && text[i] != '\n' && text[i] != '\r') {
+        if (text[i] == '"') fail("a quote inside an unquoted field (RFC 4180: quote the whole field)");
+        field += text[i++];
+      }
     }
-    record.push_back(field);
+    record.fields.push_back(field);
     // The field ends the record, or another follows.
     if (i < n && text[i] == ',') {
       ++i;
-      if (i == n) record.emplace_back();
+      if (i == n) record.fields.emplace_back();
       continue;
     }
     if (i < n && text[i] == '\r') ++i;
     if (i < n && text[i] == '\n') ++i;
     ++line;
-    if (!(record.size() == 1 && record[0].empty())) records.push_back(record);
-    record.clear();
+    if (!(record.fields.size() == 1 && record.fields[0].empty())) records.push_back(std::move(record));
+    record = CsvRow{static_cast<int>(line), {}};
   }
-  if (!record.empty()) records.push_back(record);  // the last record had no line break
+  if (!record.fields.empty()) records.push_back(std::move(record));  // the last record had no line break
   return records;
+}
+
+std::vector<std::vector<std::string>> parseCsv(std::string_view text, const std::string& source) {
+  std::vector<std::vector<std::string>> out;
+  for (CsvRow& r : parseCsvRows(text, source)) out.push_back(std::move(r.fields));
+  return out;
 }
 
 }  // namespace cairn::validation

@@ -42,7 +42,16 @@ void appendExactNumber(std::string& out, double v);
 
 // Splits CSV text into records of fields, undoing the quoting. Blank lines
 // are skipped. Throws InputError(source + ":LINE", "", why) on a quote that
-// is not closed or stray text after a closing quote.
+// is not closed, stray text after a closing quote, or a quote inside an
+// unquoted field.
 std::vector<std::vector<std::string>> parseCsv(std::string_view text, const std::string& source);
+
+// The same, each record with the line it starts on (1-based), for messages
+// that name the line of a bad value.
+struct CsvRow {
+  int line = 0;
+  std::vector<std::string> fields;
+};
+std::vector<CsvRow> parseCsvRows(std::string_view text, const std::string& source);
 
 }  // namespace cairn::validation

@@ -1,7 +1,7 @@
 #include "validation/replay_csv.hpp"
 
 #include "cairn/error.hpp"
-#include "validation/csv_records.hpp"
+#include "validation/csv.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -24,12 +24,12 @@ std::string expectedHeader() {
 }  // namespace
 
 void readRunCsv(const std::string& text, const std::string& path, Replay& replay) {
-  const std::vector<CsvRecord> records = parseCsv(text, path);
+  const std::vector<CsvRow> records = parseCsvRows(text, path);
   const auto bad = [&](int line, const std::string& why) {
     return InputError(path, "", (line > 0 ? "line " + std::to_string(line) + ": " : "") + why);
   };
   if (records.empty()) throw bad(0, "empty file: expected the header " + expectedHeader() + " (as `cairn run --out` writes)");
-  const CsvRecord& head = records.front();
+  const CsvRow& head = records.front();
   bool header_ok = head.fields.size() == kColumnCount;
   for (size_t c = 0; header_ok && c < kColumnCount; ++c) header_ok = head.fields[c] == kColumns[c];
   if (!header_ok) {
@@ -49,7 +49,7 @@ void readRunCsv(const std::string& text, const std::string& path, Replay& replay
   const size_t n = size_t(replay.bodyCount());
   long last_step = -1;
   for (size_t r = 1; r < records.size(); ++r) {
-    const CsvRecord& rec = records[r];
+    const CsvRow& rec = records[r];
     const size_t slot = (r - 1) % moving.size();
     const ReplayBody& body = replay.bodies[size_t(moving[slot])];
     if (rec.fields.size() != kColumnCount)

@@ -66,6 +66,7 @@ TEST(Csv, MalformedTextIsRefusedWithItsLine) {
   };
   refused("a,b\nc,\"open\nd,e\n", "t.csv:2: a quoted field is not closed");
   refused("a,b\n\"x\"y,z\n", "t.csv:2: text after a closing quote");
+  refused("a,b\nc,d\"e\n", "t.csv:2: a quote inside an unquoted field");
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 // page itself is tested in a browser (tests/browser/viewer_test.py).
 #include "cli_test_helpers.hpp"
 #include "cairn/error.hpp"
-#include "validation/csv_records.hpp"
+#include "validation/csv.hpp"
 #include "validation/replay_csv.hpp"
 #include "validation/replay_page.hpp"
 #include "validation/replay_record.hpp"
@@ -163,13 +163,13 @@ TEST(ReplayParting, FindsTheFirstFrameBeyondTheTolerance) {
 }
 
 TEST(CsvRecords, ReadsRfc4180QuotedFields) {
-  const auto rec = validation::parseCsv("a,\"b, \"\"c\"\"\",d\r\n\n\"multi\nline\",2\n", "x.csv");
+  const auto rec = validation::parseCsvRows("a,\"b, \"\"c\"\"\",d\r\n\n\"multi\nline\",2\n", "x.csv");
   ASSERT_EQ(rec.size(), 2u);
   EXPECT_EQ(rec[0].fields, (std::vector<std::string>{"a", "b, \"c\"", "d"}));
   EXPECT_EQ(rec[1].fields, (std::vector<std::string>{"multi\nline", "2"}));
   EXPECT_EQ(rec[1].line, 3);
-  EXPECT_THROW(validation::parseCsv("a,\"open\n", "x.csv"), InputError);
-  EXPECT_THROW(validation::parseCsv("a,b\"c\n", "x.csv"), InputError);
+  EXPECT_THROW(validation::parseCsvRows("a,\"open\n", "x.csv"), InputError);
+  EXPECT_THROW(validation::parseCsvRows("a,b\"c\n", "x.csv"), InputError);
 }
 
 // --------------------------------------------------------------- cairn view

@@ -7,6 +7,7 @@
 //   cairn_bench --table mass-ratio           hinge limit on a small box on a long arm
 //   cairn_bench --table extremes [NAME]      the extremes suite: cairn default, best, Bullet
 //   cairn_bench --table extremes-variants NAME  every setting the suite tried on those cases
+//   cairn_bench --table extremes-default [NAME]  default settings only: holds? reported? by what
 //
 // The tables measure physics, not time, so they are deterministic.
 #include <benchmark/benchmark.h>
@@ -21,6 +22,7 @@ int correctionTable();
 int massRatioTable();
 int extremesTable(const std::string& filter);
 int extremesVariantsTable(const std::string& filter);
+int extremesDefaultTable(const std::string& filter);
 }  // namespace cairn::bench
 
 int main(int argc, char** argv) {
@@ -30,6 +32,7 @@ int main(int argc, char** argv) {
     if (which == "correction") return cairn::bench::correctionTable();
     if (which == "mass-ratio") return cairn::bench::massRatioTable();
     if (which == "extremes-variants") return cairn::bench::extremesVariantsTable(argc >= 4 ? argv[3] : "");
+    if (which == "extremes-default") return cairn::bench::extremesDefaultTable(argc >= 4 ? argv[3] : "");
     if (which == "extremes") return cairn::bench::extremesTable(argc >= 4 ? argv[3] : "");
     std::cerr << "cairn_bench: --table takes chain-whip, correction, mass-ratio or extremes\n";
     return 2;

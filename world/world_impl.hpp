@@ -138,6 +138,17 @@ struct StepContext {
   std::vector<Real> island_min;
   // Per island: its rows as estimated for the exact LCP's limit (world/islands.cpp).
   std::vector<std::int64_t> island_rows_estimate;
+  // The stack watcher (world/step_diagnostics.cpp): the resting contacts
+  // that hold one body up on another (lower -1: on a static or kinematic
+  // body), and per body slot how far the stack under it has sunk and
+  // whether a sunk body rests on it.
+  struct Support {
+    std::int32_t lower, upper;
+    Real depth;
+  };
+  std::vector<Support> supports;
+  std::vector<Real> sunk;
+  std::vector<char> sunk_below;
 };
 
 class WorldImpl {

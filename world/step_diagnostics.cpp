@@ -35,9 +35,9 @@
 //                     each of them sink so, and the top sinks by their sum:
 //                     50 boxes by 15 cm with no contact deeper than 6 mm,
 //                     which the penetration watcher cannot see. With
-//                     up = -g/|g|, a contact whose normal is within 45
-//                     degrees of up, between a body and one whose centre
-//                     is lower, holds the upper body on the lower one (on
+//                     up = -g/|g|, a touching contact whose normal is
+//                     within 45 degrees of up, between a body and one whose
+//                     centre is lower, holds the upper body on the lower one (on
 //                     nothing that sinks if the lower is static or
 //                     kinematic):
 //                       sunk(upper) = max over those contacts of
@@ -202,7 +202,7 @@ void watchJoints(WorldImpl& w) {
 // Contact c as a support of one body on another (the stack watcher), if
 // it is one, with the depth it stays sunk by.
 void addSupport(const WorldImpl& w, StepContext& ctx, const Contact& c, Real depth, const Vec3& up) {
-  if (!(depth > 0)) return;
+  if (!c.touching && !(depth > 0)) return;
   const Real cos45 = std::sqrt(Real(0.5));
   const Real along = c.normal.dot(up);  // the normal points from A to B
   BodyId lower = c.body_a, upper = c.body_b;
@@ -211,7 +211,7 @@ void addSupport(const WorldImpl& w, StepContext& ctx, const Contact& c, Real dep
   if (upper.isWorld() || !w.body(upper).isDynamic() || w.body(upper).asleep) return;
   const bool sinks = !lower.isWorld() && w.body(lower).isDynamic();
   if (sinks && !((w.body(upper).position - w.body(lower).position).dot(up) > 0)) return;
-  ctx.supports.push_back({sinks ? lower.index : -1, upper.index, depth <= w.settings_.slop ? depth : Real(0)});
+  ctx.supports.push_back({sinks ? lower.index : -1, upper.index, depth > 0 && depth <= w.settings_.slop ? depth : Real(0)});
 }
 
 // Returns the deepest overlap of any contact (StepStats::max_penetration):

@@ -145,7 +145,9 @@ struct SolverSettings {
   //                       every dynamic body by its own size against gravity)
   //  joint_drift          anchor separation (m) of a joint
   //  joint_drift_angle    angle error (rad) of a joint
-  //  penetration_drift    contact penetration (m) beyond the slop
+  //  penetration_drift    contact penetration (m) beyond the slop, and a
+  //                       stack's sinking (m, its contacts' depths within
+  //                       the slop summed down to the ground) beyond it
   Real energy_rise = Real(0.1);        ///< energy gained, fraction of the energy scale (see above)
   Real joint_drift = Real(0.05);       ///< joint anchor separation, m
   Real joint_drift_angle = Real(0.2);  ///< joint angle error, rad

@@ -247,9 +247,8 @@ std::vector<ExtremeCase> extremeCases() {
     SceneDesc col = scenarios::column(10);
     col.solver.contact_erp = s.erp;
     col.solver.cfm = s.cfm;
-    out.push_back(make(std::string("column-10-") + s.label,
-                       "column-10, contact_erp " + fmtG(s.erp) + ", cfm " + fmtG(s.cfm), col, DriftMeasure::Displacement,
-                       kStack));
+    const std::string col_what = "column-10, contact_erp " + fmtG(s.erp) + ", cfm " + fmtG(s.cfm);
+    out.push_back(make(std::string("column-10-") + s.label, col_what, col, DriftMeasure::Displacement, kStack));
     SceneDesc ch = scenarios::hangingChain(20);
     ch.solver.erp = s.erp;
     ch.solver.cfm = s.cfm;

@@ -43,10 +43,10 @@
 //                       sunk(upper) = max over those contacts of
 //                                     sunk(lower) + (depth if depth <= slop, else 0),
 //                     the deepest path down to the ground, found by
-//                     relaxing the contacts until nothing changes (a
-//                     column listed bottom up takes one pass and one to
-//                     confirm; heights fall strictly along a path, so
-//                     there is no cycle). A contact deeper than the slop
+//                     relaxing the contacts until nothing changes, forward
+//                     and backward in turn (a column listed bottom up or
+//                     top down takes one pass and one to confirm; heights
+//                     fall strictly along a path, so there is no cycle). A contact deeper than the slop
 //                     adds nothing: the push-out removes contact_erp of
 //                     its excess a step, a transient (a landing pile) that
 //                     the penetration watcher reports when it is deep.
@@ -211,7 +211,8 @@ void addSupport(const WorldImpl& w, StepContext& ctx, const Contact& c, Real dep
   if (upper.isWorld() || !w.body(upper).isDynamic() || w.body(upper).asleep) return;
   const bool sinks = !lower.isWorld() && w.body(lower).isDynamic();
   if (sinks && !((w.body(upper).position - w.body(lower).position).dot(up) > 0)) return;
-  ctx.supports.push_back({sinks ? lower.index : -1, upper.index, depth > 0 && depth <= w.settings_.slop ? depth : Real(0)});
+  const Real stays = depth > 0 && depth <= w.settings_.slop ? depth : Real(0);
+  ctx.supports.push_back({sinks ? lower.index : -1, upper.index, stays});
 }
 
 // Returns the deepest overlap of any contact (StepStats::max_penetration):
@@ -254,10 +255,14 @@ void watchStacks(WorldImpl& w, StepContext& ctx) {
   std::vector<char>& below = ctx.sunk_below;
   sunk.assign(w.bodies_.size(), 0);
   below.assign(w.bodies_.size(), 0);
-  // Each pass settles at least one more support of the deepest path.
-  for (size_t pass = 0; pass <= ctx.supports.size(); ++pass) {
+  // Each pass settles at least one more support of the deepest path; the
+  // passes run forward and backward in turn, so a stack listed bottom up or
+  // top down settles in one.
+  const size_t n = ctx.supports.size();
+  for (size_t pass = 0; pass <= n; ++pass) {
     bool changed = false;
-    for (const StepContext::Support& sp : ctx.supports) {
+    for (size_t k = 0; k < n; ++k) {
+      const StepContext::Support& sp = ctx.supports[pass % 2 == 0 ? k : n - 1 - k];
       const Real d = (sp.lower < 0 ? 0 : sunk[static_cast<size_t>(sp.lower)]) + sp.depth;
       Real& u = sunk[static_cast<size_t>(sp.upper)];
       if (d > u) {
@@ -278,8 +283,8 @@ void watchStacks(WorldImpl& w, StepContext& ctx) {
     if (!(sunk[i] > tolerance) || below[i]) continue;
     w.diagnose(static_cast<std::int32_t>(i), "stack sinking",
                "the stack under it has sunk by " + fmt(sunk[i]) +
-                   " m, summed over its contacts resting within the slop (slop " + fmt(s.slop) + " + penetration_drift " +
-                   fmt(s.penetration_drift) +
+                   " m, summed over its contacts resting within the slop (slop " + fmt(s.slop) +
+                   " + penetration_drift " + fmt(s.penetration_drift) +
                    " m): the solve does not carry the stack's weight; more iterations or substeps", true);
   }
 }

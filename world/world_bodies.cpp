@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace cairn {
@@ -338,6 +339,20 @@ BodyId WorldImpl::createBody(const BodyDef& def) {
 
 // Contacts of the body (or of one of its shapes) leave the cache now; the
 // touching ones report End with the next step.
+namespace {
+
+// A body whose shapes changed has a new centre of mass, the origin of its
+// frame: its manifolds' points, fixed in that frame, moved. None of its
+// manifolds may be recycled (world_contacts.cpp); a NaN reference pose
+// fails recycling's comparisons.
+void forgetManifoldPoses(std::vector<Contact>& contacts, BodyId id) {
+  for (Contact& c : contacts)
+    if (c.body_a.index == id.index || c.body_b.index == id.index)
+      c.made_offset = Vec3::Constant(std::numeric_limits<Real>::quiet_NaN());
+}
+
+}  // namespace
+
 void WorldImpl::dropContactsOf(BodyId id, std::int32_t shape) {
   const auto involved = [&](const Contact& c) {
     if (shape >= 0) return c.shape_a == shape || c.shape_b == shape;
@@ -402,6 +417,7 @@ ShapeId WorldImpl::addShape(BodyId id, const ShapeDesc& shape) {
   b.position = trial.position;
   b.shapes = std::move(trial.shapes);
   b.updateDerived();
+  forgetManifoldPoses(contacts_, id);
   b.shape_ids.push_back(-1);
   registerShape(id, static_cast<std::int32_t>(b.shapes.size() - 1));
   const std::int32_t slot = b.shape_ids.back();
@@ -428,6 +444,7 @@ void WorldImpl::removeShape(ShapeId sid) {
   b.position = trial.position;
   b.shapes = std::move(trial.shapes);
   b.updateDerived();
+  forgetManifoldPoses(contacts_, ref.body);
   b.shape_ids.erase(b.shape_ids.begin() + removed);
   for (size_t i = static_cast<size_t>(removed); i < b.shape_ids.size(); ++i)
     shapes_[static_cast<size_t>(b.shape_ids[i])].index = static_cast<std::int32_t>(i);

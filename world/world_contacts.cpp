@@ -64,10 +64,11 @@ bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::in
     return false;
   const Quat qa_inv = ba.orientation.conjugate();
   const Vec3 offset = qa_inv * (bb.position - ba.position);
-  if ((offset - o.made_offset).squaredNorm() > s.recycle_distance * s.recycle_distance) return false;
+  // Written to fail on a NaN reference pose (a body whose shapes changed).
+  if (!((offset - o.made_offset).squaredNorm() <= s.recycle_distance * s.recycle_distance)) return false;
   // The angle between two rotations: |q1 . q2| = cos(angle / 2).
   const Quat rotation = qa_inv * bb.orientation;
-  if (std::abs(rotation.coeffs().dot(o.made_rotation.coeffs())) < std::cos(s.recycle_angle / 2)) return false;
+  if (!(std::abs(rotation.coeffs().dot(o.made_rotation.coeffs())) >= std::cos(s.recycle_angle / 2))) return false;
   Contact c = o;
   c.enabled = true;  // the callback decides again
   c.normal = ba.orientation * o.made_normal;

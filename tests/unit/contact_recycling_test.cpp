@@ -43,6 +43,28 @@ TEST(ContactRecycling, RestingBoxKeepsItsManifoldWithoutTheNarrowphase) {
   }
 }
 
+// Adding a shape moves the body's centre of mass, the origin of the frame
+// its contact points are fixed in: the next step makes a fresh manifold
+// (no recycling), even for a shift far under recycle_distance; the step
+// after recycles again. A 1 cm sphere inside the 1 kg box, 0.4 m off its
+// centre, takes its volume's share of the mass (4.2e-6) and moves the
+// centre of mass 1.7 micrometres.
+TEST(ContactRecycling, AddingAShapeMakesTheBodysManifoldsFresh) {
+  SolverSettings s;
+  s.sleeping = false;
+  World w = groundWorld(s);
+  const BodyId box = w.createBody(test::boxDef("box", Vec3(0, 0.5, 0)));
+  for (int i = 0; i < 30; ++i) w.step(kDt);
+  ASSERT_EQ(w.lastStepStats().recycled_contacts, 1);
+  ShapeDesc pebble = ShapeDesc::sphere(0.01);
+  pebble.local.p = Vec3(0.4, 0, 0);
+  w.addShape(box, pebble);
+  w.step(kDt);
+  EXPECT_EQ(w.lastStepStats().recycled_contacts, 0);
+  w.step(kDt);
+  EXPECT_EQ(w.lastStepStats().recycled_contacts, 1);
+}
+
 // A box sliding at 2 m/s without friction moves 33 mm a step, far past the
 // 1 mm bound: every step runs the narrowphase, and the ground-side points of
 // the manifold stay under the box (within its 0.5 m half extent plus the

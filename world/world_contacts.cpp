@@ -42,6 +42,17 @@ void combineMaterials(const WorldImpl& w, const Body& ba, const Body& bb, Contac
   }
 }
 
+// B's pose in A's frame: the offset R_a^T (x_b - x_a) and the rotation
+// q_a^-1 q_b (what recycling compares with where a manifold was made).
+struct RelativePose {
+  Vec3 offset;
+  Quat rotation;
+};
+RelativePose relativePose(const Body& a, const Body& b) {
+  const Quat a_inv = a.orientation.conjugate();
+  return {a_inv * (b.position - a.position), a_inv * b.orientation};
+}
+
 // Contact recycling, after Jolt's body pair cache (PhysicsSettings::
 // mBodyPairCacheMaxDeltaPositionSq and mBodyPairCacheCosMaxDeltaRotationDiv2).
 // A manifold's points are fixed on the two bodies, so while B has moved less
@@ -62,13 +73,11 @@ bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::in
   const auto next = first + 1;
   if (o.triangle != -1 || o.count == 0 || !o.touching || (next != old.end() && next->shape_a == sa && next->shape_b == sb))
     return false;
-  const Quat qa_inv = ba.orientation.conjugate();
-  const Vec3 offset = qa_inv * (bb.position - ba.position);
+  const RelativePose now = relativePose(ba, bb);
   // Written to fail on a NaN reference pose (a body whose shapes changed).
-  if (!((offset - o.made_offset).squaredNorm() <= s.recycle_distance * s.recycle_distance)) return false;
+  if (!((now.offset - o.made_offset).squaredNorm() <= s.recycle_distance * s.recycle_distance)) return false;
   // The angle between two rotations: |q1 . q2| = cos(angle / 2).
-  const Quat rotation = qa_inv * bb.orientation;
-  if (!(std::abs(rotation.coeffs().dot(o.made_rotation.coeffs())) >= std::cos(s.recycle_angle / 2))) return false;
+  if (!(std::abs(now.rotation.coeffs().dot(o.made_rotation.coeffs())) >= std::cos(s.recycle_angle / 2))) return false;
   Contact c = o;
   c.enabled = true;  // the callback decides again
   c.normal = ba.orientation * o.made_normal;
@@ -221,10 +230,10 @@ void collide(WorldImpl& w, StepContext& ctx) {
       c.normal = m.normal;
       c.count = m.count;
       combineMaterials(w, ba, bb, c);
-      const Quat qa_inv = ba.orientation.conjugate();
-      c.made_offset = qa_inv * (bb.position - ba.position);
-      c.made_rotation = qa_inv * bb.orientation;
-      c.made_normal = qa_inv * m.normal;
+      const RelativePose made = relativePose(ba, bb);
+      c.made_offset = made.offset;
+      c.made_rotation = made.rotation;
+      c.made_normal = ba.orientation.conjugate() * m.normal;
       const Transform ta = ba.transform(), tb = bb.transform();
       for (int i = 0; i < m.count; ++i) {
         ContactPointState& p = c.points[i];

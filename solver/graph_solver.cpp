@@ -100,11 +100,21 @@ void groupMomentum(GraphProblem& p, const RowGroup& g, std::span<SolverBody> bod
   }
 }
 
-// Runs fn(begin, end) over [0, count), on the pool's threads if there is one.
+// Below this much work a loop runs on the calling thread: handing a loop
+// to the pool and waiting at its barrier costs about a microsecond, as much
+// as two batch visits (a batch of eight manifolds is 0.3 to 0.5 us a visit),
+// so a colour of one or two batches (pyramid-20's) or a lone joint (each
+// colour of a chain) ran slower on two threads than on one. Work is counted
+// in batch visits; a joint's row group is about an eighth of one.
+constexpr double kParallelWork = 8;
+constexpr double kGroupWork = 1.0 / 8;
+
+// Runs fn(begin, end) over [0, count), on the pool's threads if there is one
+// and the loop's `work` (in batch visits) pays for it.
 template <class F>
-void forRange(WorkerPool* pool, int count, F&& fn) {
+void forRange(WorkerPool* pool, int count, double work, F&& fn) {
   if (count <= 0) return;
-  if (pool) pool->parallelFor(count, fn);
+  if (pool && work >= kParallelWork) pool->parallelFor(count, fn);
   else fn(0, count);
 }
 
@@ -124,7 +134,7 @@ ContactSweepParams sweepParams(const GraphProblem& p, const GraphSolveOptions& o
 template <class Groups, class Batches>
 void forColour(const GraphColour& c, WorkerPool* pool, Groups&& groups_fn, Batches&& batches_fn) {
   const int groups = c.group_end - c.group_begin, batches = c.batch_end - c.batch_begin;
-  forRange(pool, groups + batches, [&](int begin, int end) {
+  forRange(pool, groups + batches, batches + kGroupWork * groups, [&](int begin, int end) {
     for (int i = begin; i < std::min(end, groups); ++i) groups_fn(c.group_begin + i);
     const int b0 = std::max(begin, groups) - groups, b1 = end - groups;
     if (b1 > b0) batches_fn(c.batch_begin + b0, c.batch_begin + b1);
@@ -349,7 +359,7 @@ void solveGraphRestitution(GraphProblem& p, std::span<SolverBody> bodies, const 
   ContactSweepParams sp = sweepParams(p, o, false);
   sp.island_active = nullptr;
   for (const GraphColour& c : p.colours)
-    forRange(o.pool, c.batch_end - c.batch_begin, [&](int begin, int end) {
+    forRange(o.pool, c.batch_end - c.batch_begin, c.batch_end - c.batch_begin, [&](int begin, int end) {
       o.kernels->restitution(p.batches.data(), c.batch_begin + begin, c.batch_begin + end, body_data, sp);
     });
 }

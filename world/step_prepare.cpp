@@ -65,20 +65,40 @@ void store3(double (*dst)[kBatchLanes], int lane, const Vec3& v) {
 
 int tri(int i, int j) { return i * (i + 1) / 2 + j; }
 
-// Cholesky factor of the block A_b + eps I, eps = 1e-12 of its largest
-// diagonal: a face manifold's A_b is singular (4 coplanar points fix 3
-// motions), and the regularisation picks, among the impulses that give the
-// same motion, one of least norm (pgs.cpp's factorBlock).
-void factorBlock(const Real* a, Real* l) {
-  Real top = 0;
-  for (int i = 0; i < 4; ++i) top = std::max(top, a[tri(i, i)]);
-  const Real eps = Real(1e-12) * top;
+// Cholesky factors of the blocks A_b + eps I of a batch's eight lanes,
+// eps = 1e-12 of the block's largest diagonal: a face manifold's A_b is
+// singular (4 coplanar points fix 3 motions), and the regularisation picks,
+// among the impulses that give the same motion, one of least norm (pgs.cpp's
+// factorBlock). The lanes are the inner loop: a factor is a chain of four
+// square roots and six divisions, each waiting for the last, and eight
+// independent chains side by side keep the divider busy where one chain
+// left it waiting (a fifth of fillLane's time when each lane was factored
+// alone). Each lane's arithmetic is the same as alone, so are its bits.
+void factorBatch(ContactBatch& b) {
+  double eps[kBatchLanes];
+  for (int l = 0; l < kBatchLanes; ++l) {
+    Real top = 0;
+    for (int i = 0; i < 4; ++i) top = std::max(top, b.block[tri(i, i)][l]);
+    eps[l] = Real(1e-12) * top;
+  }
   for (int i = 0; i < 4; ++i)
-    for (int j = 0; j <= i; ++j) {
-      Real sum = a[tri(i, j)] + (i == j ? eps : Real(0));
-      for (int k = 0; k < j; ++k) sum -= l[tri(i, k)] * l[tri(j, k)];
-      l[tri(i, j)] = i == j ? std::sqrt(std::max(sum, eps)) : sum / l[tri(j, j)];
-    }
+    for (int j = 0; j <= i; ++j)
+      for (int l = 0; l < kBatchLanes; ++l) {
+        Real sum = b.block[tri(i, j)][l] + (i == j ? eps[l] : Real(0));
+        for (int k = 0; k < j; ++k) sum -= b.factor[tri(i, k)][l] * b.factor[tri(j, k)][l];
+        b.factor[tri(i, j)][l] = i == j ? std::sqrt(std::max(sum, eps[l])) : sum / b.factor[tri(j, j)][l];
+      }
+}
+
+// The effective masses 1 / (A_ii + cfm) of a batch's rows, from the
+// diagonals fillLane left in their place (0: no row), lanes innermost for
+// the same reason as factorBatch.
+void invertRowMasses(ContactBatch& b) {
+  for (int i = 0; i < kMaxPoints; ++i) {
+    ContactBatch::Point& q = b.p[i];
+    for (Real* m : {q.normal_mass, q.tangent_mass[0], q.tangent_mass[1]})
+      for (int l = 0; l < kBatchLanes; ++l) m[l] = m[l] > 0 ? 1 / m[l] : Real(0);
+  }
 }
 
 struct ContactParams {
@@ -109,11 +129,11 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
   const Vec3 m_ab = ma + mb;
   const auto linear = [&](const Vec3& u) { return u.dot(m_ab.cwiseProduct(u)); };
 
-  Vec3 ran[kMaxPoints], rbn[kMaxPoints];
+  Vec3 ran[kMaxPoints], rbn[kMaxPoints], ia_ran[kMaxPoints], ib_rbn[kMaxPoints];  // and I^-1 (r x n)
   bool valid[kMaxPoints] = {};
   for (int i = 0; i < kMaxPoints; ++i) {
     ContactBatch::Point& q = batch.p[i];
-    ran[i] = rbn[i] = Vec3::Zero();
+    ran[i] = rbn[i] = ia_ran[i] = ib_rbn[i] = Vec3::Zero();
     q.valid[lane] = 0;
     q.lambda[lane] = q.lambda_t[0][lane] = q.lambda_t[1][lane] = 0;
     q.max_lambda[lane] = q.lambda_bias[lane] = 0;
@@ -130,13 +150,15 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
     const Vec3 ra = pa - a.x, rb = pb - b.x;
     ran[i] = ra.cross(n);
     rbn[i] = rb.cross(n);
-    const Real k = linear(n) + ran[i].dot(a.inv_inertia * ran[i]) + rbn[i].dot(b.inv_inertia * rbn[i]);
+    ia_ran[i] = a.inv_inertia * ran[i];
+    ib_rbn[i] = b.inv_inertia * rbn[i];
+    const Real k = linear(n) + ran[i].dot(ia_ran[i]) + rbn[i].dot(ib_rbn[i]);
     if (!(k > 0)) continue;  // neither body can move along the normal here (locks)
     valid[i] = true;
     q.valid[lane] = 1;
     store3(q.ran, lane, ran[i]);
     store3(q.rbn, lane, rbn[i]);
-    q.normal_mass[lane] = 1 / (k + cp.cfm);
+    q.normal_mass[lane] = k + cp.cfm;  // inverted by invertRowMasses
 
     // Targets: close a gap within the step and no more (speculative); push
     // the penetration beyond the slop out at contact_erp / h.
@@ -166,8 +188,9 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
     const Vec3 vt = vrel - n * n.dot(vrel);
     const Vec3 carried = s.friction_impulse - n * n.dot(s.friction_impulse);
     Vec3 t1;
-    if (vt.norm() > Real(1e-3)) t1 = vt.normalized();
-    else if (carried.norm() > Real(1e-12)) t1 = carried.normalized();
+    const Real vt2 = vt.squaredNorm(), carried2 = carried.squaredNorm();  // one square root, not two
+    if (vt2 > Real(1e-6)) t1 = vt / std::sqrt(vt2);
+    else if (carried2 > Real(1e-24)) t1 = carried / std::sqrt(carried2);
     else t1 = anyPerpendicular(n);
     store3(q.t, lane, t1);
     if (c.friction > 0) {
@@ -179,7 +202,7 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
         store3(q.rat[k2], lane, rat);
         store3(q.rbt[k2], lane, rbt);
         const Real kt = linear(t) + rat.dot(a.inv_inertia * rat) + rbt.dot(b.inv_inertia * rbt);
-        q.tangent_mass[k2][lane] = kt + cp.cfm > 0 ? 1 / (kt + cp.cfm) : 0;
+        q.tangent_mass[k2][lane] = kt + cp.cfm;  // inverted by invertRowMasses (<= 0: no row)
         q.lambda_t[k2][lane] = cp.warm * s.friction_impulse.dot(t);
       }
     }
@@ -187,11 +210,6 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
 
   // The normal block, padded to 4 x 4 with identity rows.
   const Real lin_n = linear(n);
-  const Vec3 ia_ran[kMaxPoints] = {a.inv_inertia * ran[0], a.inv_inertia * ran[1], a.inv_inertia * ran[2],
-                                   a.inv_inertia * ran[3]};
-  const Vec3 ib_rbn[kMaxPoints] = {b.inv_inertia * rbn[0], b.inv_inertia * rbn[1], b.inv_inertia * rbn[2],
-                                   b.inv_inertia * rbn[3]};
-  Real blk[10], fac[10];
   for (int i = 0; i < kMaxPoints; ++i)
     for (int j = 0; j <= i; ++j) {
       Real v;
@@ -199,13 +217,9 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
         v = lin_n + ran[i].dot(ia_ran[j]) + rbn[i].dot(ib_rbn[j]) + (i == j ? cp.cfm : Real(0));
       else
         v = i == j ? Real(1) : Real(0);
-      blk[tri(i, j)] = v;
+      batch.block[tri(i, j)][lane] = v;
     }
-  factorBlock(blk, fac);
-  for (int k = 0; k < 10; ++k) {
-    batch.block[k][lane] = blk[k];
-    batch.factor[k][lane] = fac[k];
-  }
+  // factorBatch and invertRowMasses finish the lane with its batch.
 }
 
 // An empty lane: the world on both sides, no points.
@@ -481,14 +495,10 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   for (size_t k = 0; k < sorted.size(); ++k) {
     const Item& it = sorted[k];
     const size_t c = static_cast<size_t>(ctx.colour_of[k]);
-    if (it.kind == Item::Manifold) {
+    if (it.kind == Item::Manifold) {  // its lane now, filled below
       const std::int32_t slot = lane_fill[c]++;
       ctx.lane_contact[static_cast<size_t>(slot)] = it.index;
-      const Contact& con = w.contacts_[static_cast<size_t>(it.index)];
-      bool pushing = false;
-      fillLane(g.batches[static_cast<size_t>(slot / kBatchLanes)], slot % kBatchLanes, con, solverView(w, ctx, con.body_a),
-               solverView(w, ctx, con.body_b), it.island, cp, pushing);
-      if (pushing) ctx.island_pushing[static_cast<size_t>(it.island)] = 1;
+      g.batches[static_cast<size_t>(slot / kBatchLanes)].island[slot % kBatchLanes] = it.island;
       continue;
     }
     const std::int32_t gi = group_fill[c]++;
@@ -509,10 +519,27 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
     for (std::int32_t r = grp.begin; r < grp.end; ++r)
       if (g.rows[static_cast<size_t>(r)].bias_rhs > 0) ctx.island_pushing[static_cast<size_t>(it.island)] = 1;
   }
-  for (std::int32_t c = 0; c < colours; ++c) {  // pad each colour's last batch
-    const GraphColour& gc = g.colours[static_cast<size_t>(c)];
-    for (std::int32_t slot = lane_fill[static_cast<size_t>(c)]; slot < gc.batch_end * kBatchLanes; ++slot)
-      padLane(g.batches[static_cast<size_t>(slot / kBatchLanes)], slot % kBatchLanes);
+  // The lanes in storage order, a batch's eight one after another: a batch
+  // is 11.5 KB, a cache line per field, and filling its lanes at eight
+  // different times (in the level order above) brought it into the cache
+  // eight times, which made this loop a fifth of an awake pyramid's step.
+  for (size_t slot = 0; slot < ctx.lane_contact.size(); ++slot) {
+    ContactBatch& batch = g.batches[slot / kBatchLanes];
+    const int lane = static_cast<int>(slot % kBatchLanes);
+    const std::int32_t ci = ctx.lane_contact[slot];
+    if (ci < 0) {  // the rest of a colour's last batch
+      padLane(batch, lane);
+      continue;
+    }
+    const Contact& con = w.contacts_[static_cast<size_t>(ci)];
+    const std::int32_t island = batch.island[lane];
+    bool pushing = false;
+    fillLane(batch, lane, con, solverView(w, ctx, con.body_a), solverView(w, ctx, con.body_b), island, cp, pushing);
+    if (pushing) ctx.island_pushing[static_cast<size_t>(island)] = 1;
+  }
+  for (ContactBatch& batch : g.batches) {
+    factorBatch(batch);
+    invertRowMasses(batch);
   }
 
   // 7. The other islands: generic rows island by island, joints first, then

@@ -185,12 +185,10 @@ void updateSleep(WorldImpl& w, StepContext& ctx) {
       if (!c.enabled || c.count == 0) continue;
       const std::int32_t isl = std::max(c.body_a.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(c.body_a.index)],
                                         c.body_b.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(c.body_b.index)]);
-      if (isl < 0) continue;
-      const BodyView a = w.view(c.body_a), b = w.view(c.body_b);
-      for (int i = 0; i < c.count; ++i) {
-        const Real depth = -(worldPoint(b, c.points[i].local_b) - worldPoint(a, c.points[i].local_a)).dot(c.normal);
-        if (depth > s.slop + done) island_min[static_cast<size_t>(isl)] = 0;
-      }
+      // Only an island about to sleep needs the look (an awake pyramid's
+      // contacts cost this stage most of its time).
+      if (isl < 0 || island_min[static_cast<size_t>(isl)] < s.sleep_time) continue;
+      if (w.contactDepth(c) > s.slop + done) island_min[static_cast<size_t>(isl)] = 0;
     }
     for (std::int32_t si = 1; si <= ctx.dynamic_count && si < static_cast<std::int32_t>(ctx.pseudo.size()); ++si) {
       const SolverBody& p = ctx.pseudo[static_cast<size_t>(si)];

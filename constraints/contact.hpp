@@ -52,6 +52,8 @@ struct Contact {
   bool enabled = true;                      // a callback may veto
   bool touching = false;                    // some point within the margin this step
   bool began = false;                       // first step touching (for events)
+  bool carried = false;                     // this step's copy of last step's manifold (asleep or recycled):
+                                            // its impulses are already its own, nothing to match
   Real depth_after = 0;                     // deepest overlap after the last step (the penetration watcher)
   // Where the narrowphase made this manifold, in A's frame (for recycling,
   // world/world_contacts.cpp): B's offset R_a^T (x_b - x_a), B's rotation

@@ -65,7 +65,7 @@ RelativePose relativePose(const Body& a, const Body& b) {
 // mesh triangles) is recycled. Returns whether `out` got the recycled contact.
 bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::int32_t sa, std::int32_t sb,
                      const std::vector<Contact>::const_iterator first, const std::vector<Contact>& old,
-                     std::vector<Contact>& out) {
+                     Real cos_half_angle, std::vector<Contact>& out) {
   const SolverSettings& s = w.settings_;
   if (!(s.recycle_distance > 0) || !(s.recycle_angle > 0)) return false;
   if (first == old.end() || first->shape_a != sa || first->shape_b != sb) return false;
@@ -77,9 +77,10 @@ bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::in
   // Written to fail on a NaN reference pose (a body whose shapes changed).
   if (!((now.offset - o.made_offset).squaredNorm() <= s.recycle_distance * s.recycle_distance)) return false;
   // The angle between two rotations: |q1 . q2| = cos(angle / 2).
-  if (!(std::abs(now.rotation.coeffs().dot(o.made_rotation.coeffs())) >= std::cos(s.recycle_angle / 2))) return false;
+  if (!(std::abs(now.rotation.coeffs().dot(o.made_rotation.coeffs())) >= cos_half_angle)) return false;
   Contact c = o;
   c.enabled = true;  // the callback decides again
+  c.carried = true;
   c.normal = ba.orientation * o.made_normal;
   combineMaterials(w, ba, bb, c);
   const Transform ta = ba.transform(), tb = bb.transform();
@@ -186,6 +187,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
   const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
   if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key))
     std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
+  const Real cos_half_angle = std::cos(settings_.recycle_angle / 2);
   for (const auto& [pa, pb] : w.pairs_) {
     std::int32_t sa = broadphase_.user(pa), sb = broadphase_.user(pb);
     if (sa > sb) std::swap(sa, sb);
@@ -205,11 +207,13 @@ void collide(WorldImpl& w, StepContext& ctx) {
     const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
     if (a_still && b_still && (ba.asleep || bb.asleep)) {
       // Nothing here moves: keep the cached contacts as they were.
-      for (auto it = cached; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it)
+      for (auto it = cached; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
         contacts_.push_back(*it);
+        contacts_.back().carried = true;
+      }
       continue;
     }
-    if (recycleManifold(w, ba, bb, sa, sb, cached, old_contacts_, contacts_)) {
+    if (recycleManifold(w, ba, bb, sa, sb, cached, old_contacts_, cos_half_angle, contacts_)) {
       ++w.stats_.recycled_contacts;
       continue;
     }
@@ -258,6 +262,10 @@ void collide(WorldImpl& w, StepContext& ctx) {
   // 3. Warm start: carry impulses from last step's points with the same
   //    feature id (or, failing that, within 2 cm on body A).
   for (Contact& c : contacts_) {
+    if (c.carried) {  // last step's own manifold: its impulses came with it
+      c.began = !c.touching;
+      continue;
+    }
     const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
                                      [](const Contact& x, std::uint64_t k) { return x.key() < k; });
     if (it == old_contacts_.end() || it->key() != c.key()) {

@@ -2,6 +2,7 @@
 #include "collision/broadphase.hpp"
 
 #include <algorithm>
+#include <iterator>
 
 namespace cairn {
 
@@ -168,9 +169,15 @@ void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
                                 }),
                  pairs_.end());
   }
-  pairs_.insert(pairs_.end(), fresh_.begin(), fresh_.end());
-  std::sort(pairs_.begin(), pairs_.end());
-  pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+  // pairs_ stays sorted and unique between calls: sort only what is new
+  // and merge it in (a scene at rest adds nothing and sorts nothing).
+  if (!fresh_.empty()) {
+    std::sort(fresh_.begin(), fresh_.end());
+    merged_.clear();  // std::inplace_merge would allocate a buffer each call
+    std::merge(pairs_.begin(), pairs_.end(), fresh_.begin(), fresh_.end(), std::back_inserter(merged_));
+    std::swap(pairs_, merged_);
+    pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+  }
 
   for (int h : moved_) proxies_[h].moved = false;
   for (int h : dirty_) proxies_[h].dirty = false;

@@ -162,6 +162,7 @@ class BroadPhase {
   std::vector<int> moved_;     // handles to re-query, in order of marking
   std::vector<int> dirty_;     // handles whose old pairs are stale
   std::vector<std::pair<int, int>> pairs_;
+  std::vector<std::pair<int, int>> merged_;  // scratch for merging fresh pairs in
   std::vector<std::pair<int, int>> fresh_;  // scratch for updatePairs
   std::vector<int> capped_;
   int max_pairs_ = 64;

@@ -141,17 +141,23 @@ void WorldImpl::setPairMaterial(BodyId a, BodyId b, Real friction, Real restitut
   else pair_materials_.insert(it, {key, friction, restitution});
 }
 
+namespace {
+// Two body slots (the world is -1) as one key, whichever comes first.
+std::uint64_t bodyPairKey(std::int32_t a, std::int32_t b) {
+  if (a > b) std::swap(a, b);
+  return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b);
+}
+}  // namespace
+
 bool WorldImpl::shouldCollide(const Body& a, const Body& b, BodyId ia, BodyId ib) const {
   if (ia.index == ib.index) return false;
   if (!a.isDynamic() && !b.isDynamic()) return false;  // static and kinematic never collide with each other
   if ((a.collision_group & b.collision_mask) == 0 || (b.collision_group & a.collision_mask) == 0) return false;
-  // A pair that shares a joint does not collide unless the joint says so.
-  for (const Joint& j : joints_) {
-    if (!j.alive || j.broken || j.def.collide_connected) continue;
-    if ((j.def.body_a.index == ia.index && j.def.body_b.index == ib.index) ||
-        (j.def.body_a.index == ib.index && j.def.body_b.index == ia.index))
-      return false;
-  }
+  // A pair that shares a joint does not collide unless the joint says so
+  // (the sorted list collide() makes each step: a search, not a walk over
+  // every joint for every pair).
+  if (std::binary_search(ctx_.jointed_pairs.begin(), ctx_.jointed_pairs.end(), bodyPairKey(ia.index, ib.index)))
+    return false;
   if (filter_callback_ && !filter_callback_(ia, ib)) return false;
   return true;
 }
@@ -188,6 +194,12 @@ void collide(WorldImpl& w, StepContext& ctx) {
   if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key))
     std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
   const Real cos_half_angle = std::cos(settings_.recycle_angle / 2);
+  std::vector<std::uint64_t>& jointed = ctx.jointed_pairs;
+  jointed.clear();
+  for (const Joint& j : w.joints_)
+    if (j.alive && !j.broken && !j.def.collide_connected)
+      jointed.push_back(bodyPairKey(j.def.body_a.index, j.def.body_b.index));
+  std::sort(jointed.begin(), jointed.end());
   for (const auto& [pa, pb] : w.pairs_) {
     std::int32_t sa = broadphase_.user(pa), sb = broadphase_.user(pb);
     if (sa > sb) std::swap(sa, sb);

@@ -148,6 +148,7 @@ struct StepContext {
   };
   std::vector<Support> supports;
   std::vector<Real> sunk;
+  std::vector<std::uint64_t> jointed_pairs;  // body pairs a joint keeps from colliding, sorted (collide)
   std::vector<char> sunk_below;
 };
 

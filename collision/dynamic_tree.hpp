@@ -7,10 +7,11 @@
 // the new leaf L with node S under a new parent costs
 //   SA(S u L)                          the new parent's area
 //   + sum over ancestors A of S of SA(A u L) - SA(A)   their growth,
-// and the best S over the whole tree is found by branch and bound: below a
-// node whose ancestors already grew by g, nothing can cost less than
-// SA(L) + g (Bittner, Hapala, Havran 2013; Catto, "Dynamic Bounding Volume
-// Hierarchies", GDC 2019).
+// and S is found by one descent from the root that follows the child whose
+// subtree could cost least and stops when no subtree can beat the best S
+// seen (Bittner, Hapala, Havran 2013, bound the search the same way; Catto,
+// "Dynamic Bounding Volume Hierarchies", GDC 2019, and Box2D v3 descend one
+// path; dynamic_tree.cpp says why one path).
 //
 // Balance: after every insert and remove, the path to the root is refitted
 // and each node whose children's heights differ by more than one is rotated
@@ -135,12 +136,7 @@ class DynamicTree {
   void refit(int i);
   void refitUpFrom(int i);
 
-  struct Candidate {
-    int node;
-    Real growth;  // area the ancestors of `node` gain from the new leaf
-  };
   std::vector<Node> nodes_;
-  std::vector<Candidate> search_;  // insertion's priority queue, reused
   int root_ = -1;
   int free_ = -1;
   int leaves_ = 0;

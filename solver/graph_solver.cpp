@@ -100,13 +100,17 @@ void groupMomentum(GraphProblem& p, const RowGroup& g, std::span<SolverBody> bod
   }
 }
 
-// Below this much work a loop runs on the calling thread: handing a loop
-// to the pool and waiting at its barrier costs about a microsecond, as much
-// as two batch visits (a batch of eight manifolds is 0.3 to 0.5 us a visit),
-// so a colour of one or two batches (pyramid-20's) or a lone joint (each
-// colour of a chain) ran slower on two threads than on one. Work is counted
-// in batch visits; a joint's row group is about an eighth of one.
-constexpr double kParallelWork = 8;
+// Below this much work a loop runs on the calling thread. A batch visit
+// (eight manifolds, one pass) is 0.5 to 1 us; handing a loop to the pool
+// and meeting at its barrier costs about a microsecond. Measured on an idle
+// machine with every colour handed over: a colour of one to three batches
+// (pyramid-20's) or a lone joint (each colour of a chain) ran slower on
+// two threads than on one (ragdoll 0.050 -> 0.084 ms/step, pyramid-20 0.40
+// -> 0.43), while the 5,050-box pyramid, five batches a colour on average,
+// gained 1.56x in its solve. Four batches, two per thread, is where the
+// handover starts to pay. Work is counted in batch visits; a joint's row
+// group is about an eighth of one.
+constexpr double kParallelWork = 4;
 constexpr double kGroupWork = 1.0 / 8;
 
 // Runs fn(begin, end) over [0, count), on the pool's threads if there is one

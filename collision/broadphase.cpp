@@ -125,7 +125,8 @@ void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) 
   free_ = free_head;
 }
 
-void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
+bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
+  const bool changed = !moved_.empty() || !dirty_.empty();
   // 1. Pairs found by querying each moved proxy. A query stops at
   //    max_pairs_ other proxies (the bound in the header). A pair of two
   //    moved proxies may be found twice (the sort below keeps one): keeping
@@ -184,6 +185,7 @@ void BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
   moved_.clear();
   dirty_.clear();
   out.assign(pairs_.begin(), pairs_.end());
+  return changed;
 }
 
 }  // namespace cairn

@@ -68,8 +68,10 @@ class BroadPhase {
   bool moveProxy(int handle, const Aabb& tight, const Vec3& displacement = Vec3::Zero());
 
   // Every pair of proxies whose fat boxes overlap, each once as (lo, hi)
-  // handles with lo < hi, sorted. `out` is overwritten.
-  void updatePairs(std::vector<std::pair<int, int>>& out);
+  // handles with lo < hi, sorted. `out` is overwritten. Returns false when
+  // no proxy moved, was created or died since the last call: the pairs are
+  // the last call's.
+  bool updatePairs(std::vector<std::pair<int, int>>& out);
 
   // The broadphase as plain data (snapshots, world/snapshot_state.cpp):
   // per handle its fat box, user, owner, liveness and free-list link, and the head

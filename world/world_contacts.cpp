@@ -175,6 +175,23 @@ Real WorldImpl::contactDepth(const Contact& c) const {
   return depth;
 }
 
+namespace {
+// Whether every candidate pair is between bodies that cannot move this
+// step (both asleep or not dynamic, one asleep: the pair loop's "nothing
+// here moves") and may still collide.
+bool pairsAtRest(const WorldImpl& w) {
+  for (const auto& [pa, pb] : w.pairs_) {
+    const ShapeRef& ra = w.shapes_[static_cast<size_t>(w.broadphase_.user(pa))];
+    const ShapeRef& rb = w.shapes_[static_cast<size_t>(w.broadphase_.user(pb))];
+    const Body& ba = w.body(ra.body);
+    const Body& bb = w.body(rb.body);
+    const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
+    if (!(a_still && b_still && (ba.asleep || bb.asleep)) || !w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
+  }
+  return true;
+}
+}  // namespace
+
 void collide(WorldImpl& w, StepContext& ctx) {
   const Real h = ctx.h;
   const SolverSettings& settings_ = w.settings_;
@@ -185,117 +202,130 @@ void collide(WorldImpl& w, StepContext& ctx) {
   // 1. Broadphase: move the proxies of bodies that can move.
   w.moveProxies(kWorldBody, h);
   broadphase_.setMaxPairsPerProxy(settings_.max_pairs_per_shape);
-  broadphase_.updatePairs(w.pairs_);
-
-  // 2. Narrowphase over the candidate pairs, matching last step's contacts.
-  std::swap(old_contacts_, contacts_);
-  contacts_.clear();
-  const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
-  if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key))
-    std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
-  const Real cos_half_angle = std::cos(settings_.recycle_angle / 2);
-  std::vector<std::uint64_t>& jointed = ctx.jointed_pairs;
+  const bool pairs_changed = broadphase_.updatePairs(w.pairs_);
+  std::vector<std::uint64_t>& jointed = ctx.jointed_pairs;  // for shouldCollide
   jointed.clear();
   for (const Joint& j : w.joints_)
     if (j.alive && !j.broken && !j.def.collide_connected)
       jointed.push_back(bodyPairKey(j.def.body_a.index, j.def.body_b.index));
   std::sort(jointed.begin(), jointed.end());
-  for (const auto& [pa, pb] : w.pairs_) {
-    std::int32_t sa = broadphase_.user(pa), sb = broadphase_.user(pb);
-    if (sa > sb) std::swap(sa, sb);
-    const ShapeRef& ra = w.shapes_[static_cast<size_t>(sa)];
-    const ShapeRef& rb = w.shapes_[static_cast<size_t>(sb)];
-    const Body& ba = body(ra.body);
-    const Body& bb = body(rb.body);
-    if (!w.shouldCollide(ba, bb, ra.body, rb.body)) continue;
-    // Last step's contacts of this pair. They are sorted by key, whose high
-    // bits are the two shapes: a binary search.
-    Contact probe;
-    probe.shape_a = sa;
-    probe.shape_b = sb;
-    probe.triangle = -1;
-    const auto cached = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), probe.key(),
-                                         [](const Contact& x, std::uint64_t k) { return x.key() < k; });
-    const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
-    if (a_still && b_still && (ba.asleep || bb.asleep)) {
-      // Nothing here moves: keep the cached contacts as they were.
-      for (auto it = cached; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
-        contacts_.push_back(*it);
-        contacts_.back().carried = true;
-      }
-      continue;
-    }
-    if (recycleManifold(w, ba, bb, sa, sb, cached, old_contacts_, cos_half_angle, contacts_)) {
-      ++w.stats_.recycled_contacts;
-      continue;
-    }
-    const ShapeDesc& sda = ba.shapes[static_cast<size_t>(ra.index)];
-    const ShapeDesc& sdb = bb.shapes[static_cast<size_t>(rb.index)];
-    const Real margin = std::max(reach(ba, settings_.contact_margin, h), reach(bb, settings_.contact_margin, h));
-    std::vector<Manifold>& manifolds_ = w.manifolds_;
-    manifolds_.clear();
-    cairn::collide(sda, ba.transform() * sda.local, sdb, bb.transform() * sdb.local, margin, manifolds_);
-    for (const Manifold& m : manifolds_) {
-      if (m.count == 0) continue;
-      Contact c;
-      c.shape_a = sa;
-      c.shape_b = sb;
-      c.triangle = m.triangle;
-      c.body_a = ra.body;
-      c.body_b = rb.body;
-      c.normal = m.normal;
-      c.count = m.count;
-      combineMaterials(w, ba, bb, c);
-      const RelativePose made = relativePose(ba, bb);
-      c.made_offset = made.offset;
-      c.made_rotation = made.rotation;
-      c.made_normal = ba.orientation.conjugate() * m.normal;
-      const Transform ta = ba.transform(), tb = bb.transform();
-      for (int i = 0; i < m.count; ++i) {
-        ContactPointState& p = c.points[i];
-        const ContactPoint& q = m.points[i];
-        p.feature_id = q.feature_id;
-        p.depth = q.depth;
-        // Surface points: A's at position + n d/2, B's at position - n d/2.
-        const Vec3 on_a = q.position + m.normal * (q.depth / 2), on_b = q.position - m.normal * (q.depth / 2);
-        p.local_a = ta.applyInverse(on_a);
-        p.local_b = tb.applyInverse(on_b);
-        p.approach_speed = m.normal.dot(bb.velocityAt(on_b) - ba.velocityAt(on_a));
-      }
-      c.touching = true;
-      contacts_.push_back(c);
-    }
-  }
-  // Contacts in key order (deterministic, and for the lookup below). The
-  // broadphase hands pairs over in a stable order, so this is usually
-  // sorted already: checking first spares moving every contact.
-  if (!std::is_sorted(contacts_.begin(), contacts_.end(), by_key)) std::stable_sort(contacts_.begin(), contacts_.end(), by_key);
 
-  // 3. Warm start: carry impulses from last step's points with the same
-  //    feature id (or, failing that, within 2 cm on body A).
-  for (Contact& c : contacts_) {
-    if (c.carried) {  // last step's own manifold: its impulses came with it
+  // A world at rest: the same pairs as last step, every one between bodies
+  // that cannot move. The pass below would copy each contact as it was
+  // (a fully asleep pile-1000's collide was mostly that copy); instead the
+  // contacts stay where they are, and last step's list is emptied so that
+  // the events see nothing end.
+  if (!pairs_changed && pairsAtRest(w)) {
+    old_contacts_.clear();
+    for (Contact& c : contacts_) {
+      c.carried = true;
       c.began = !c.touching;
-      continue;
     }
-    const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
-                                     [](const Contact& x, std::uint64_t k) { return x.key() < k; });
-    if (it == old_contacts_.end() || it->key() != c.key()) {
-      c.began = true;
-      continue;
+  } else {
+    // 2. Narrowphase over the candidate pairs, matching last step's contacts.
+    std::swap(old_contacts_, contacts_);
+    contacts_.clear();
+    const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
+    if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key))
+      std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
+    const Real cos_half_angle = std::cos(settings_.recycle_angle / 2);
+    for (const auto& [pa, pb] : w.pairs_) {
+      std::int32_t sa = broadphase_.user(pa), sb = broadphase_.user(pb);
+      if (sa > sb) std::swap(sa, sb);
+      const ShapeRef& ra = w.shapes_[static_cast<size_t>(sa)];
+      const ShapeRef& rb = w.shapes_[static_cast<size_t>(sb)];
+      const Body& ba = body(ra.body);
+      const Body& bb = body(rb.body);
+      if (!w.shouldCollide(ba, bb, ra.body, rb.body)) continue;
+      // Last step's contacts of this pair. They are sorted by key, whose high
+      // bits are the two shapes: a binary search.
+      Contact probe;
+      probe.shape_a = sa;
+      probe.shape_b = sb;
+      probe.triangle = -1;
+      const auto cached = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), probe.key(),
+                                           [](const Contact& x, std::uint64_t k) { return x.key() < k; });
+      const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
+      if (a_still && b_still && (ba.asleep || bb.asleep)) {
+        // Nothing here moves: keep the cached contacts as they were.
+        for (auto it = cached; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
+          contacts_.push_back(*it);
+          contacts_.back().carried = true;
+        }
+        continue;
+      }
+      if (recycleManifold(w, ba, bb, sa, sb, cached, old_contacts_, cos_half_angle, contacts_)) {
+        ++w.stats_.recycled_contacts;
+        continue;
+      }
+      const ShapeDesc& sda = ba.shapes[static_cast<size_t>(ra.index)];
+      const ShapeDesc& sdb = bb.shapes[static_cast<size_t>(rb.index)];
+      const Real margin = std::max(reach(ba, settings_.contact_margin, h), reach(bb, settings_.contact_margin, h));
+      std::vector<Manifold>& manifolds_ = w.manifolds_;
+      manifolds_.clear();
+      cairn::collide(sda, ba.transform() * sda.local, sdb, bb.transform() * sdb.local, margin, manifolds_);
+      for (const Manifold& m : manifolds_) {
+        if (m.count == 0) continue;
+        Contact c;
+        c.shape_a = sa;
+        c.shape_b = sb;
+        c.triangle = m.triangle;
+        c.body_a = ra.body;
+        c.body_b = rb.body;
+        c.normal = m.normal;
+        c.count = m.count;
+        combineMaterials(w, ba, bb, c);
+        const RelativePose made = relativePose(ba, bb);
+        c.made_offset = made.offset;
+        c.made_rotation = made.rotation;
+        c.made_normal = ba.orientation.conjugate() * m.normal;
+        const Transform ta = ba.transform(), tb = bb.transform();
+        for (int i = 0; i < m.count; ++i) {
+          ContactPointState& p = c.points[i];
+          const ContactPoint& q = m.points[i];
+          p.feature_id = q.feature_id;
+          p.depth = q.depth;
+          // Surface points: A's at position + n d/2, B's at position - n d/2.
+          const Vec3 on_a = q.position + m.normal * (q.depth / 2), on_b = q.position - m.normal * (q.depth / 2);
+          p.local_a = ta.applyInverse(on_a);
+          p.local_b = tb.applyInverse(on_b);
+          p.approach_speed = m.normal.dot(bb.velocityAt(on_b) - ba.velocityAt(on_a));
+        }
+        c.touching = true;
+        contacts_.push_back(c);
+      }
     }
-    c.began = !it->touching;
-    c.rolling_impulse = it->rolling_impulse;
-    for (int i = 0; i < c.count; ++i) {
-      ContactPointState& p = c.points[i];
-      const ContactPointState* match = nullptr;
-      for (int k = 0; k < it->count && !match; ++k)
-        if (it->points[k].feature_id == p.feature_id) match = &it->points[k];
-      for (int k = 0; k < it->count && !match; ++k)
-        if ((it->points[k].local_a - p.local_a).squaredNorm() < Real(4e-4)) match = &it->points[k];
-      if (match) {
-        p.normal_impulse = match->normal_impulse;
-        p.friction_impulse = match->friction_impulse;
+    // Contacts in key order (deterministic, and for the lookup below). The
+    // broadphase hands pairs over in a stable order, so this is usually
+    // sorted already: checking first spares moving every contact.
+    if (!std::is_sorted(contacts_.begin(), contacts_.end(), by_key)) std::stable_sort(contacts_.begin(), contacts_.end(), by_key);
+
+    // 3. Warm start: carry impulses from last step's points with the same
+    //    feature id (or, failing that, within 2 cm on body A).
+    for (Contact& c : contacts_) {
+      if (c.carried) {  // last step's own manifold: its impulses came with it
+        c.began = !c.touching;
+        continue;
+      }
+      const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
+                                       [](const Contact& x, std::uint64_t k) { return x.key() < k; });
+      if (it == old_contacts_.end() || it->key() != c.key()) {
+        c.began = true;
+        continue;
+      }
+      c.began = !it->touching;
+      c.rolling_impulse = it->rolling_impulse;
+      for (int i = 0; i < c.count; ++i) {
+        ContactPointState& p = c.points[i];
+        const ContactPointState* match = nullptr;
+        for (int k = 0; k < it->count && !match; ++k)
+          if (it->points[k].feature_id == p.feature_id) match = &it->points[k];
+        for (int k = 0; k < it->count && !match; ++k)
+          if ((it->points[k].local_a - p.local_a).squaredNorm() < Real(4e-4)) match = &it->points[k];
+        if (match) {
+          p.normal_impulse = match->normal_impulse;
+          p.friction_impulse = match->friction_impulse;
+        }
       }
     }
   }

@@ -223,6 +223,41 @@ TEST(Sleeping, RestingBodySleepsAndWakesWhenHit) {
   EXPECT_GT(cairn::detail::internals(w).body(box).position.x(), 0.01);  // it was pushed
 }
 
+// A world at rest keeps its contacts as they were, impulses and all, and
+// reports no event however long it sleeps (collide leaves them in place
+// instead of rebuilding the list); taking a body away still ends its
+// contacts, and the stack below wakes and steps on.
+TEST(Sleeping, AWorldAtRestKeepsItsContactsAndEndsThemWhenABodyGoes) {
+  World w;
+  addGroundPlane(w);
+  w.createBody(test::boxDef("bottom", Vec3(0, 0.5, 0)));
+  const BodyId top = w.createBody(test::boxDef("top", Vec3(0, 1.5, 0)));
+  for (int s = 0; s < 240 && w.lastStepStats().sleeping_bodies < 2; ++s) w.step(kH);
+  ASSERT_EQ(w.lastStepStats().sleeping_bodies, 2);
+  w.step(kH);
+  const std::vector<cairn::Contact> resting = cairn::detail::internals(w).contacts_;
+  ASSERT_EQ(resting.size(), 2u);  // ground-bottom, bottom-top
+  for (int s = 0; s < 120; ++s) {
+    w.step(kH);
+    EXPECT_TRUE(w.contactEvents().empty());
+  }
+  const std::vector<cairn::Contact>& now = cairn::detail::internals(w).contacts_;
+  ASSERT_EQ(now.size(), resting.size());
+  for (size_t k = 0; k < now.size(); ++k) {
+    EXPECT_EQ(now[k].key(), resting[k].key());
+    for (int i = 0; i < now[k].count; ++i) {
+      EXPECT_EQ(now[k].points[i].normal_impulse, resting[k].points[i].normal_impulse);
+      EXPECT_EQ(now[k].points[i].local_a, resting[k].points[i].local_a);
+    }
+  }
+  w.destroyBody(top);
+  w.step(kH);
+  int ends = 0;
+  for (const auto& e : w.contactEvents()) ends += e.type == ContactEvent::Type::End;
+  EXPECT_EQ(ends, 1);  // the top box's contact with the bottom one
+  EXPECT_EQ(cairn::detail::internals(w).contacts_.size(), 1u);
+}
+
 // Events: a dropped box begins one contact with the ground, with the
 // landing impulse; lifting it off ends it.
 TEST(Events, BeginWithImpulseAndEnd) {

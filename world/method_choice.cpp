@@ -41,13 +41,6 @@ constexpr int kChainJointsPerSweep = 4;
 constexpr Real kDriftLimit = Real(0.01);  // m
 constexpr int kExactRows = 240;
 
-struct IslandFacts {
-  Real min_mass = kInf, max_mass = 0;
-  int joints = 0, contact_points = 0;
-  Real joint_error = 0;
-  bool drifted = false;  // a body of it was marked by an earlier joint_drift
-};
-
 }  // namespace
 
 void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
@@ -55,7 +48,8 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
   const auto n = static_cast<size_t>(ctx.island_count);
   ctx.island_reason.assign(n, MethodReason::Setting);
   if (s.method != SolverMethod::Auto) return;
-  std::vector<IslandFacts> facts(n);
+  std::vector<IslandFacts>& facts = ctx.island_facts;  // scratch: no allocation once warm
+  facts.assign(n, IslandFacts{});
   const auto islandOf = [&](BodyId id) {
     return id.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(id.index)];
   };
@@ -93,12 +87,16 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
       ctx.island_method[isl] = SolverMethod::PGS;
       continue;
     }
-    if (why == MethodReason::JointDrift)
-      for (size_t i = 0; i < w.bodies_.size(); ++i)
-        if (ctx.body_island[i] == static_cast<std::int32_t>(isl)) ctx.body_drifted[i] = 1;
     const int rows = 6 * f.joints + 3 * f.contact_points;  // at most
     const int exact_rows = std::min(kExactRows, s.max_exact_rows);
     ctx.island_method[isl] = f.contact_points > 0 && rows <= exact_rows ? SolverMethod::LCP : SolverMethod::Direct;
+  }
+  // The joint_drift islands' bodies keep the mark (one pass over the bodies).
+  for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    const std::int32_t isl = ctx.body_island[i];
+    if (isl >= 0 && ctx.island_reason[static_cast<size_t>(isl)] == MethodReason::JointDrift &&
+        ctx.island_method[static_cast<size_t>(isl)] != SolverMethod::PGS)
+      ctx.body_drifted[i] = 1;
   }
 }
 

@@ -62,6 +62,15 @@ struct GraphItem {
   std::int32_t island;
 };
 
+// What solver.method = "auto" learns of an island before choosing its
+// solver (world/method_choice.cpp).
+struct IslandFacts {
+  Real min_mass = kInf, max_mass = 0;
+  int joints = 0, contact_points = 0;
+  Real joint_error = 0;
+  bool drifted = false;  // a body of it was marked by an earlier joint_drift
+};
+
 // What one step's stages hand each other (docs/architecture.md). Sized
 // once and reused: after the first steps of a scene nothing here allocates.
 struct StepContext {
@@ -77,6 +86,7 @@ struct StepContext {
   std::vector<SolverMethod> island_method;  // how each island is solved this step
   std::vector<MethodReason> island_reason;  // and why (world/method_choice.cpp)
   std::vector<char> body_drifted;           // per body slot: its island once left PGS for joint drift
+  std::vector<IslandFacts> island_facts;    // scratch of the choice, per island
 
   // Solver order (world/step_prepare.cpp): index 0 for the world and every
   // static body, then the awake dynamic bodies island by island (1 to

@@ -54,7 +54,7 @@ enum class SolverMethod { PGS, Direct, LCP, Auto };
 const char* solverMethodName(SolverMethod m);  ///< lower-case name, as in scene files
 /// The solver settings of a World (World::setSettings).
 struct SolverSettings {
-  SolverMethod method = SolverMethod::PGS;  ///< the velocity solver, per island; Auto picks per island (world/method_choice.cpp)
+  SolverMethod method = SolverMethod::Auto;  ///< the velocity solver, per island; Auto (default) picks per island (world/method_choice.cpp)
   int iterations = 10;          ///< PGS sweeps per step (Bullet: 10)
   /// Newton steps of the nonlinear joint position pass after each (sub)step,
   /// for islands solved directly or exactly (solver/position_pass.hpp); 0: off.

@@ -15,11 +15,20 @@
 //   long_chain   it has more joints than 4 x the sweeps (at 10 sweeps, 40:
 //                hanging-chain-20 holds to 1.4 mm on PGS, 1000 links open
 //                by metres);
-//   joint_drift  a rigid joint of it is open by more than 1 cm at the
-//                step's start: PGS's residual did not fall last step (the
-//                extremes' hanging-chain limit, 2% of a 0.5 m link). Its
-//                bodies keep the mark (hysteresis): an island that holds
-//                only because it left PGS would drift again on return.
+//   joint_drift  a rigid joint of it has been open by more than 1 cm (the
+//                extremes' hanging-chain limit, 2% of a 0.5 m link) at
+//                the start of kDriftSteps = 5 steps in a row without
+//                closing (its error never smaller than the step before):
+//                PGS's residual does not fall. ERP's feedback alone
+//                removes 1 - (1 - ERP)^5 = 67% of an error in 5 steps at
+//                the default ERP 0.2 (1/ERP steps, Baumgarte's time
+//                constant), so an error that grew or held for that long
+//                is one the sweeps leave, not a transient: a ragdoll
+//                landing opens its hips by 1.3 cm for 4 steps on PGS and
+//                closes (stays PGS), a whipping chain opens for hundreds
+//                of steps (leaves it). Its bodies keep the mark
+//                (hysteresis): an island that holds only because it left
+//                PGS would drift again on return.
 //
 // Everything else stays PGS. An ill-conditioned island goes to the exact
 // pivoting LCP solver (solver/lcp_exact.hpp) when it has contacts and at
@@ -39,6 +48,7 @@ namespace {
 constexpr Real kMassRatio = 100;
 constexpr int kChainJointsPerSweep = 4;
 constexpr Real kDriftLimit = Real(0.01);  // m
+constexpr std::uint8_t kDriftSteps = 5;
 constexpr int kExactRows = 240;
 
 }  // namespace
@@ -62,14 +72,25 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
     f.min_mass = std::min(f.min_mass, w.bodies_[i].mass);
     f.max_mass = std::max(f.max_mass, w.bodies_[i].mass);
   }
-  for (const Joint& j : w.joints_) {
-    if (!j.alive || j.broken) continue;
+  ctx.joint_error_last.resize(w.joints_.size(), 0);
+  ctx.joint_drift_run.resize(w.joints_.size(), 0);
+  for (size_t i = 0; i < w.joints_.size(); ++i) {
+    const Joint& j = w.joints_[i];
+    if (!j.alive || j.broken) {
+      ctx.joint_error_last[i] = 0;
+      ctx.joint_drift_run[i] = 0;
+      continue;
+    }
     const std::int32_t isl = std::max(islandOf(j.def.body_a), islandOf(j.def.body_b));
     if (isl < 0) continue;
     IslandFacts& f = facts[static_cast<size_t>(isl)];
     ++f.joints;
-    if (!j.def.softness.isSet())
-      f.joint_error = std::max(f.joint_error, measureJointError(j, w.view(j.def.body_a), w.view(j.def.body_b)).linear);
+    if (j.def.softness.isSet()) continue;
+    const Real error = measureJointError(j, w.view(j.def.body_a), w.view(j.def.body_b)).linear;
+    std::uint8_t& run = ctx.joint_drift_run[i];
+    run = error > kDriftLimit && error >= ctx.joint_error_last[i] ? static_cast<std::uint8_t>(std::min(run + 1, 255)) : 0;
+    ctx.joint_error_last[i] = error;
+    f.drifting = f.drifting || run >= kDriftSteps;
   }
   for (const Contact& c : w.contacts_) {
     if (!c.enabled || c.count == 0) continue;
@@ -81,7 +102,7 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
     MethodReason why = MethodReason::WellConditioned;
     if (f.max_mass >= kMassRatio * f.min_mass) why = MethodReason::MassRatio;
     else if (f.joints > kChainJointsPerSweep * s.iterations) why = MethodReason::LongChain;
-    else if (f.drifted || f.joint_error > kDriftLimit) why = MethodReason::JointDrift;
+    else if (f.drifted || f.drifting) why = MethodReason::JointDrift;
     ctx.island_reason[isl] = why;
     if (why == MethodReason::WellConditioned || f.joints + f.contact_points == 0) {
       ctx.island_method[isl] = SolverMethod::PGS;

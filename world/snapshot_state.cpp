@@ -584,6 +584,8 @@ void ioWorld(Ar& ar, WorldImpl& w) {
     ar(v);
     x = static_cast<char>(v);
   });
+  io(ar, w.ctx_.joint_error_last);
+  ioEach(ar, w.ctx_.joint_drift_run, [&ar](std::uint8_t& x) { ar(x); });
 }
 
 }  // namespace

@@ -67,8 +67,8 @@ struct GraphItem {
 struct IslandFacts {
   Real min_mass = kInf, max_mass = 0;
   int joints = 0, contact_points = 0;
-  Real joint_error = 0;
-  bool drifted = false;  // a body of it was marked by an earlier joint_drift
+  bool drifted = false;   // a body of it was marked by an earlier joint_drift
+  bool drifting = false;  // a joint of it has not closed for kDriftSteps steps
 };
 
 // What one step's stages hand each other (docs/architecture.md). Sized
@@ -87,6 +87,8 @@ struct StepContext {
   std::vector<MethodReason> island_reason;  // and why (world/method_choice.cpp)
   std::vector<char> body_drifted;           // per body slot: its island once left PGS for joint drift
   std::vector<IslandFacts> island_facts;    // scratch of the choice, per island
+  std::vector<Real> joint_error_last;       // per joint slot: its anchor separation at the last step's start
+  std::vector<std::uint8_t> joint_drift_run;  // per joint slot: steps in a row it was open and not closing
 
   // Solver order (world/step_prepare.cpp): index 0 for the world and every
   // static body, then the awake dynamic bodies island by island (1 to

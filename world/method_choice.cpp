@@ -26,7 +26,13 @@
 //                is one the sweeps leave, not a transient: a ragdoll
 //                landing opens its hips by 1.3 cm for 4 steps on PGS and
 //                closes (stays PGS), a whipping chain opens for hundreds
-//                of steps (leaves it). Its bodies keep the mark
+//                of steps (leaves it). A joint open by more than 2 cm
+//                (kDriftAtOnce) leaves at once: an error that oscillates
+//                without closing (two distance joints asking different
+//                lengths) never grows 5 steps in a row, and the later
+//                auto leaves, the wider the gap the position pass closes
+//                on arrival (its velocities follow the positions, a kick
+//                that adds energy). Its bodies keep the mark
 //                (hysteresis): an island that holds only because it left
 //                PGS would drift again on return.
 //
@@ -49,6 +55,7 @@ constexpr Real kMassRatio = 100;
 constexpr int kChainJointsPerSweep = 4;
 constexpr Real kDriftLimit = Real(0.01);  // m
 constexpr std::uint8_t kDriftSteps = 5;
+constexpr Real kDriftAtOnce = 2 * kDriftLimit;  // m
 constexpr int kExactRows = 240;
 
 }  // namespace
@@ -90,7 +97,7 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
     std::uint8_t& run = ctx.joint_drift_run[i];
     run = error > kDriftLimit && error >= ctx.joint_error_last[i] ? static_cast<std::uint8_t>(std::min(run + 1, 255)) : 0;
     ctx.joint_error_last[i] = error;
-    f.drifting = f.drifting || run >= kDriftSteps;
+    f.drifting = f.drifting || run >= kDriftSteps || error > kDriftAtOnce;
   }
   for (const Contact& c : w.contacts_) {
     if (!c.enabled || c.count == 0) continue;

@@ -13,6 +13,8 @@
 #include "solver/position_pass.hpp"
 #include "world/position_pass_stage.hpp"
 
+#include <algorithm>
+
 namespace cairn::detail {
 
 namespace {
@@ -27,9 +29,14 @@ bool rigidBilateral(const ConstraintRow& r) {
 void recordJointErrors(WorldImpl& w, StepContext& ctx) {
   ctx.joint_error_start.assign(w.joints_.size(), 0);
   if (w.settings_.position_iterations <= 0) return;
+  const auto islandOf = [&](BodyId id) { return id.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(id.index)]; };
   for (size_t i = 0; i < w.joints_.size(); ++i) {
     const Joint& j = w.joints_[i];
-    if (j.alive && !j.broken) ctx.joint_error_start[i] = measureJointError(j, w.view(j.def.body_a), w.view(j.def.body_b)).linear;
+    if (!j.alive || j.broken) continue;
+    // Only the joints the pass may correct: PGS islands get no pass.
+    const std::int32_t isl = std::max(islandOf(j.def.body_a), islandOf(j.def.body_b));
+    if (isl < 0 || ctx.island_method[static_cast<size_t>(isl)] == SolverMethod::PGS) continue;
+    ctx.joint_error_start[i] = measureJointError(j, w.view(j.def.body_a), w.view(j.def.body_b)).linear;
   }
 }
 

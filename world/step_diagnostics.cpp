@@ -36,18 +36,19 @@
 //                     50 boxes by 15 cm with no contact deeper than 6 mm,
 //                     which the penetration watcher cannot see. With
 //                     up = -g/|g|, a touching contact whose normal is
-//                     within 45 degrees of up, between a body and one whose
-//                     centre is lower, holds the upper body on the lower one (on
-//                     nothing that sinks if the lower is static or
-//                     kinematic):
+//                     within 45 degrees of up, between a body and one
+//                     whose centre is lower, holds the upper body on the
+//                     lower one (on nothing that sinks if the lower is
+//                     static or kinematic):
 //                       sunk(upper) = max over those contacts of
 //                                     sunk(lower) + (depth if depth <= slop, else 0),
 //                     the deepest path down to the ground, found by
 //                     relaxing the contacts until nothing changes, forward
 //                     and backward in turn (a column listed bottom up or
 //                     top down takes one pass and one to confirm; heights
-//                     fall strictly along a path, so there is no cycle). A contact deeper than the slop
-//                     adds nothing: the push-out removes contact_erp of
+//                     fall strictly along a path, so there is no cycle).
+//                     A contact deeper than the slop adds nothing: the
+//                     push-out removes contact_erp of
 //                     its excess a step, a transient (a landing pile) that
 //                     the penetration watcher reports when it is deep.
 //                     Reported on the top body of each sunk stack.

@@ -337,8 +337,6 @@ BodyId WorldImpl::createBody(const BodyDef& def) {
   return id;
 }
 
-// Contacts of the body (or of one of its shapes) leave the cache now; the
-// touching ones report End with the next step.
 namespace {
 
 // A body whose shapes changed has a new centre of mass, the origin of its
@@ -353,6 +351,8 @@ void forgetManifoldPoses(std::vector<Contact>& contacts, BodyId id) {
 
 }  // namespace
 
+// Contacts of the body (or of one of its shapes) leave the cache now; the
+// touching ones report End with the next step.
 void WorldImpl::dropContactsOf(BodyId id, std::int32_t shape) {
   const auto involved = [&](const Contact& c) {
     if (shape >= 0) return c.shape_a == shape || c.shape_b == shape;

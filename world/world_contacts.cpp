@@ -176,17 +176,20 @@ Real WorldImpl::contactDepth(const Contact& c) const {
 }
 
 namespace {
-// Whether every candidate pair is between bodies that cannot move this
-// step (both asleep or not dynamic, one asleep: the pair loop's "nothing
-// here moves") and may still collide.
+// A pair of bodies of which nothing moves this step: both asleep or not
+// dynamic, one asleep. Its contacts stay as they were.
+bool pairAtRest(const Body& a, const Body& b) {
+  return (a.asleep || !a.isDynamic()) && (b.asleep || !b.isDynamic()) && (a.asleep || b.asleep);
+}
+
+// Whether every candidate pair is at rest and may still collide.
 bool pairsAtRest(const WorldImpl& w) {
   for (const auto& [pa, pb] : w.pairs_) {
     const ShapeRef& ra = w.shapes_[static_cast<size_t>(w.broadphase_.user(pa))];
     const ShapeRef& rb = w.shapes_[static_cast<size_t>(w.broadphase_.user(pb))];
     const Body& ba = w.body(ra.body);
     const Body& bb = w.body(rb.body);
-    const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
-    if (!(a_still && b_still && (ba.asleep || bb.asleep)) || !w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
+    if (!pairAtRest(ba, bb) || !w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
   }
   return true;
 }
@@ -217,10 +220,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
   // the events see nothing end.
   if (!pairs_changed && pairsAtRest(w)) {
     old_contacts_.clear();
-    for (Contact& c : contacts_) {
-      c.carried = true;
-      c.began = !c.touching;
-    }
+    for (Contact& c : contacts_) c.carried = true;
   } else {
     // 2. Narrowphase over the candidate pairs, matching last step's contacts.
     std::swap(old_contacts_, contacts_);
@@ -245,9 +245,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
       probe.triangle = -1;
       const auto cached = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), probe.key(),
                                            [](const Contact& x, std::uint64_t k) { return x.key() < k; });
-      const bool a_still = ba.asleep || !ba.isDynamic(), b_still = bb.asleep || !bb.isDynamic();
-      if (a_still && b_still && (ba.asleep || bb.asleep)) {
-        // Nothing here moves: keep the cached contacts as they were.
+      if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were
         for (auto it = cached; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
           contacts_.push_back(*it);
           contacts_.back().carried = true;
@@ -299,33 +297,33 @@ void collide(WorldImpl& w, StepContext& ctx) {
     // broadphase hands pairs over in a stable order, so this is usually
     // sorted already: checking first spares moving every contact.
     if (!std::is_sorted(contacts_.begin(), contacts_.end(), by_key)) std::stable_sort(contacts_.begin(), contacts_.end(), by_key);
+  }
 
-    // 3. Warm start: carry impulses from last step's points with the same
-    //    feature id (or, failing that, within 2 cm on body A).
-    for (Contact& c : contacts_) {
-      if (c.carried) {  // last step's own manifold: its impulses came with it
-        c.began = !c.touching;
-        continue;
-      }
-      const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
-                                       [](const Contact& x, std::uint64_t k) { return x.key() < k; });
-      if (it == old_contacts_.end() || it->key() != c.key()) {
-        c.began = true;
-        continue;
-      }
-      c.began = !it->touching;
-      c.rolling_impulse = it->rolling_impulse;
-      for (int i = 0; i < c.count; ++i) {
-        ContactPointState& p = c.points[i];
-        const ContactPointState* match = nullptr;
-        for (int k = 0; k < it->count && !match; ++k)
-          if (it->points[k].feature_id == p.feature_id) match = &it->points[k];
-        for (int k = 0; k < it->count && !match; ++k)
-          if ((it->points[k].local_a - p.local_a).squaredNorm() < Real(4e-4)) match = &it->points[k];
-        if (match) {
-          p.normal_impulse = match->normal_impulse;
-          p.friction_impulse = match->friction_impulse;
-        }
+  // 3. Warm start: carry impulses from last step's points with the same
+  //    feature id (or, failing that, within 2 cm on body A).
+  for (Contact& c : contacts_) {
+    if (c.carried) {  // last step's own manifold: its impulses came with it
+      c.began = !c.touching;
+      continue;
+    }
+    const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
+                                     [](const Contact& x, std::uint64_t k) { return x.key() < k; });
+    if (it == old_contacts_.end() || it->key() != c.key()) {
+      c.began = true;
+      continue;
+    }
+    c.began = !it->touching;
+    c.rolling_impulse = it->rolling_impulse;
+    for (int i = 0; i < c.count; ++i) {
+      ContactPointState& p = c.points[i];
+      const ContactPointState* match = nullptr;
+      for (int k = 0; k < it->count && !match; ++k)
+        if (it->points[k].feature_id == p.feature_id) match = &it->points[k];
+      for (int k = 0; k < it->count && !match; ++k)
+        if ((it->points[k].local_a - p.local_a).squaredNorm() < Real(4e-4)) match = &it->points[k];
+      if (match) {
+        p.normal_impulse = match->normal_impulse;
+        p.friction_impulse = match->friction_impulse;
       }
     }
   }

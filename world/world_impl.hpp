@@ -160,8 +160,9 @@ struct StepContext {
   };
   std::vector<Support> supports;
   std::vector<Real> sunk;
-  std::vector<std::uint64_t> jointed_pairs;  // body pairs a joint keeps from colliding, sorted (collide)
   std::vector<char> sunk_below;
+  // Body pairs a joint keeps from colliding, sorted (collide, shouldCollide).
+  std::vector<std::uint64_t> jointed_pairs;
 };
 
 class WorldImpl {

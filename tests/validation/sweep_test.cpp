@@ -82,6 +82,28 @@ void expectParetoConsistent(const std::vector<Row>& rows, const std::string& axi
   EXPECT_GE(marked, 1);
 }
 
+// auto beside pgs: on the 1:1000 box on box auto's exact solve keeps the
+// light box within the slop (0.5 cm) where 10 PGS sweeps let the heavy one
+// sink several centimetres (docs/extremes.md), and the table says which
+// method each row used.
+TEST(Sweep, ShowsAutoBesidePgs) {
+  TempDir tmp;
+  const CliResult r = cairn("sweep mass-ratio-1000 --vary method=auto,pgs --steps 120 --out " + tmp / "out", tmp);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = readCsv(tmp / "out/sweep.csv");
+  ASSERT_GE(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("method"), "auto");
+  EXPECT_EQ(rows[1].at("method"), "pgs");
+  EXPECT_LT(num(rows[0], "penetration_m"), 0.005);
+  EXPECT_GT(num(rows[1], "penetration_m"), 0.005);
+
+  // cairn validate the same: the heavy box stays where it was stacked (1 cm,
+  // the scenario's tolerance) with auto, not with pgs (exit status 1: a
+  // figure outside its tolerance).
+  EXPECT_EQ(cairn("validate mass-ratio-1000 --steps 30 --method auto", tmp).status, 0);
+  EXPECT_EQ(cairn("validate mass-ratio-1000 --steps 30 --method pgs", tmp).status, 1);
+}
+
 bool haveMatplotlib() { return std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0; }
 
 TEST(Sweep, WritesTableAndParetoPlotWithConsistentMarks) {

@@ -98,6 +98,14 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
   return true;
 }
 
+void BroadPhase::setFilter(int h, std::uint32_t group, std::uint32_t mask) {
+  Proxy& p = proxies_[h];
+  if (p.group == group && p.mask == mask) return;
+  p.group = group;
+  p.mask = mask;
+  markMoved(h);
+}
+
 std::vector<BroadPhase::ProxyState> BroadPhase::proxyStates() const {
   std::vector<ProxyState> out;
   out.reserve(proxies_.size());
@@ -141,6 +149,7 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
     auto add = [&](int o) {
       const Proxy& po = proxies_[o];
       if (o == m || (pm.owner >= 0 && po.owner == pm.owner)) return true;
+      if ((pm.group & po.mask) == 0 || (po.group & pm.mask) == 0) return true;
       fresh_.emplace_back(std::min(m, o), std::max(m, o));
       if (pm.leaf < 0 || po.leaf < 0 || ++found < max_pairs_) return true;
       capped_.push_back(m);

@@ -14,7 +14,7 @@ namespace cairn::validation {
 
 namespace {
 
-enum class Type { Method, Int, Real, Bool };
+enum class Type { Method, Correction, Int, Real, Bool };
 
 struct Key {
   const char* name;
@@ -30,6 +30,7 @@ constexpr Key kKeys[] = {
     {"split_impulse", Type::Bool}, {"slop", Type::Real},        {"nncg", Type::Bool},
     {"sleeping", Type::Bool},     {"geometric_stiffness", Type::Bool}, {"position_iterations", Type::Int},
     {"recycle_distance", Type::Real}, {"recycle_angle", Type::Real}, {"friction_directions", Type::Int},
+    {"position_correction", Type::Correction},
 };
 
 const Key* findKey(const std::string& name) {
@@ -99,6 +100,14 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
           found = true;
         }
       if (!found) bad(option, value, "is not a method (auto, pgs, direct or lcp)");
+      break;
+    }
+    case Type::Correction: {
+      // The scene file's names (world/scene_json.cpp).
+      if (value == "baumgarte") s.position_correction = Correction::VelocityBias;
+      else if (value == "split") s.position_correction = Correction::PseudoVelocity;
+      else if (value == "single_pass") s.position_correction = Correction::InRhs;
+      else bad(option, value, "is not a position correction (baumgarte, split or single_pass)");
       break;
     }
     case Type::Int: {
@@ -175,6 +184,13 @@ std::string solverKeyValue(const SceneDesc& scene, const std::string& key) {
   if (key == "recycle_distance") return exactNumberText(s.recycle_distance);
   if (key == "recycle_angle") return exactNumberText(s.recycle_angle);
   if (key == "friction_directions") return std::to_string(s.friction_directions);
+  if (key == "position_correction") {
+    switch (s.position_correction) {
+      case Correction::VelocityBias: return "baumgarte";
+      case Correction::PseudoVelocity: return "split";
+      case Correction::InRhs: return "single_pass";
+    }
+  }
   throw InputError("solver", key, "unknown setting");
 }
 

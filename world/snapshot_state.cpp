@@ -552,6 +552,12 @@ void ioWorld(Ar& ar, WorldImpl& w) {
   if constexpr (Ar::reading) {
     checkBroadPhaseState(w, proxies, free_proxy, ar.object());
     w.broadphase_.restore(proxies, free_proxy);
+    // The filter bits are the bodies' (not stored twice).
+    for (const ShapeRef& ref : w.shapes_)
+      if (ref.alive) {
+        const Body& b = w.body(ref.body);
+        w.broadphase_.setFilter(ref.proxy, b.collision_group, b.collision_mask);
+      }
   }
   ar.at("contacts");
   io(ar, w.contacts_);

@@ -55,7 +55,8 @@
 //   fast body without CCD
 //                     a body without continuous collision moved, in one
 //                     step, further than its own thickness plus that of a
-//                     shape its path overlaps: it can pass through that
+//                     shape its path overlaps and that it collides with
+//                     (filter bits, joints): it can pass through that
 //                     shape without ever touching it (the classic
 //                     tunnelling of discrete collision: Ericson, "Real-Time
 //                     Collision Detection", section 9.5; Bullet and Jolt
@@ -300,7 +301,17 @@ Real thickness(const ShapeDesc& shape) {
   return (box.hi - box.lo).minCoeff();
 }
 
+// The thinnest shape in the world, for watchFastBodies: a body that moved
+// no further than its own thickness plus this cannot have passed anything.
+Real thinnestShape(const WorldImpl& w) {
+  Real thinnest = kInf;
+  for (const ShapeRef& ref : w.shapes_)
+    if (ref.alive) thinnest = std::min(thinnest, thickness(w.body(ref.body).shapes[static_cast<size_t>(ref.index)]));
+  return thinnest;
+}
+
 void watchFastBodies(WorldImpl& w, StepContext& ctx) {
+  Real thinnest = -1;  // found once per step, and only when a body is fast enough to need it
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
     const Body& b = w.bodies_[i];
     if (!b.alive || !b.isDynamic() || b.asleep || b.ccd || b.shapes.empty()) continue;
@@ -312,6 +323,8 @@ void watchFastBodies(WorldImpl& w, StepContext& ctx) {
     Real own = kInf;
     for (const ShapeDesc& s : b.shapes) own = std::min(own, thickness(s));
     if (!(travel > own)) continue;
+    if (thinnest < 0) thinnest = thinnestShape(w);
+    if (!(travel > own + thinnest)) continue;  // the query below would find nothing
     const Aabb path{from.cwiseMin(to), from.cwiseMax(to)};
     std::int32_t passed = -1;
     Real passed_thickness = 0;
@@ -321,6 +334,9 @@ void watchFastBodies(WorldImpl& w, StepContext& ctx) {
     w.broadphase_.query(path, [&](int proxy) {
       const ShapeRef& ref = w.shapes_[static_cast<size_t>(w.broadphase_.user(proxy))];
       if (!ref.alive || ref.body.index == static_cast<std::int32_t>(i)) return true;
+      // A shape the body never collides with (filter bits, a shared joint)
+      // is one it may pass through.
+      if (!w.shouldCollide(b, w.body(ref.body), w.bodyId(static_cast<int>(i)), ref.body)) return true;
       const Real t = thickness(w.body(ref.body).shapes[static_cast<size_t>(ref.index)]);
       if (!(travel > own + t)) return true;
       if (passed < 0 || ref.body.index < passed) {

@@ -290,6 +290,8 @@ void World::setCollisionFilter(BodyId id, std::uint32_t group, std::uint32_t mas
   Body& b = impl_->body(id);
   b.collision_group = group;
   b.collision_mask = mask;
+  for (const std::int32_t slot : b.shape_ids)
+    if (slot >= 0) impl_->broadphase_.setFilter(impl_->shapes_[static_cast<size_t>(slot)].proxy, group, mask);
   impl_->wakeBody(id);
 }
 

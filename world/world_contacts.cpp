@@ -115,6 +115,7 @@ void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
   Aabb box = shapeAabb(shape, b.transform() * shape.local);
   if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
   ref.proxy = broadphase_.createProxy(box, slot, Vec3::Zero(), id.index);  // a body's own shapes never pair
+  broadphase_.setFilter(ref.proxy, b.collision_group, b.collision_mask);
   b.shape_ids[static_cast<size_t>(index_in_body)] = slot;
 }
 

@@ -140,5 +140,26 @@ TEST(BroadPhasePairs, SlowProxyInsideItsFatBoxIsNotReinserted) {
   EXPECT_EQ(bp.user(h), 7);
 }
 
+// Filter bits (Bullet's group/mask rule): overlapping proxies pair only when
+// each one's group meets the other's mask, and a changed filter re-pairs at
+// the next update without the proxies moving.
+TEST(BroadPhasePairs, FilterBitsDecideWhichOverlapsPair) {
+  BroadPhase bp(0.1);
+  const Aabb box = Aabb::fromCenterHalf(Vec3::Zero(), Vec3::Constant(0.5));
+  const int a = bp.createProxy(box, 0), b = bp.createProxy(box, 1), c = bp.createProxy(box, 2);
+  bp.setFilter(a, 1, ~2u);  // a ignores group 2
+  bp.setFilter(b, 2, ~0u);  // b would take anyone
+  std::vector<std::pair<int, int>> pairs;
+  bp.updatePairs(pairs);
+  EXPECT_EQ(pairs, (std::vector<std::pair<int, int>>{{a, c}, {b, c}}));
+  EXPECT_FALSE(bp.updatePairs(pairs));  // nothing changed
+  bp.setFilter(a, 1, ~0u);
+  EXPECT_TRUE(bp.updatePairs(pairs));
+  EXPECT_EQ(pairs, (std::vector<std::pair<int, int>>{{a, b}, {a, c}, {b, c}}));
+  bp.setFilter(c, 4, 4);  // c only with group 4: nobody
+  bp.updatePairs(pairs);
+  EXPECT_EQ(pairs, (std::vector<std::pair<int, int>>{{a, b}}));
+}
+
 }  // namespace
 }  // namespace cairn

@@ -318,8 +318,15 @@ TEST(Filtering, FrictionlessContactsMakeNoFrictionRowsAndFiltersApply) {
     a.collision_group = 1;
     a.collision_mask = ~2u;
     b.collision_group = 2;
-    w.createBody(a);
+    const BodyId ia = w.createBody(a);
     w.createBody(b);
+    w.step(kH);
+    EXPECT_EQ(w.lastStepStats().contacts, 0);
+    // Filters changed between steps take effect at the next one, both ways.
+    w.setCollisionFilter(ia, 1, ~0u);
+    w.step(kH);
+    EXPECT_EQ(w.lastStepStats().contacts, 1);
+    w.setCollisionFilter(ia, 1, ~2u);
     w.step(kH);
     EXPECT_EQ(w.lastStepStats().contacts, 0);
   }

@@ -101,6 +101,11 @@ void invertRowMasses(ContactBatch& b) {
   }
 }
 
+// Batches below which the lanes are filled on the calling thread: at about
+// a microsecond a batch, sixteen split over two threads outweigh the
+// handover (solver/graph_solver.cpp measures the same trade for the solve).
+constexpr int kParallelBatches = 16;
+
 struct ContactParams {
   Real h = 0, cfm = 0, contact_erp = 0, slop = 0, threshold = 0, max_correction = 0, warm = 0;
   Correction correction = Correction::PseudoVelocity;
@@ -523,24 +528,36 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   // is 11.5 KB, a cache line per field, and filling its lanes at eight
   // different times (in the level order above) brought it into the cache
   // eight times, which made this loop a fifth of an awake pyramid's step.
-  for (size_t slot = 0; slot < ctx.lane_contact.size(); ++slot) {
-    ContactBatch& batch = g.batches[slot / kBatchLanes];
-    const int lane = static_cast<int>(slot % kBatchLanes);
-    const std::int32_t ci = ctx.lane_contact[slot];
-    if (ci < 0) {  // the rest of a colour's last batch
-      padLane(batch, lane);
-      continue;
+  // Each batch is filled and factored on its own, so the batches are split
+  // among the pool's threads when there are enough of them (a batch is
+  // about a microsecond of work, as much as handing a loop over); which
+  // island pushes is gathered afterwards, in storage order.
+  ctx.lane_pushing.assign(ctx.lane_contact.size(), 0);
+  const auto fillBatches = [&](int begin, int end) {
+    for (int bi = begin; bi < end; ++bi) {
+      ContactBatch& batch = g.batches[static_cast<size_t>(bi)];
+      for (int lane = 0; lane < kBatchLanes; ++lane) {
+        const size_t slot = static_cast<size_t>(bi) * kBatchLanes + static_cast<size_t>(lane);
+        const std::int32_t ci = ctx.lane_contact[slot];
+        if (ci < 0) {  // the rest of a colour's last batch
+          padLane(batch, lane);
+          continue;
+        }
+        const Contact& con = w.contacts_[static_cast<size_t>(ci)];
+        bool pushing = false;
+        fillLane(batch, lane, con, solverView(w, ctx, con.body_a), solverView(w, ctx, con.body_b), batch.island[lane],
+                 cp, pushing);
+        ctx.lane_pushing[slot] = pushing;
+      }
+      factorBatch(batch);
+      invertRowMasses(batch);
     }
-    const Contact& con = w.contacts_[static_cast<size_t>(ci)];
-    const std::int32_t island = batch.island[lane];
-    bool pushing = false;
-    fillLane(batch, lane, con, solverView(w, ctx, con.body_a), solverView(w, ctx, con.body_b), island, cp, pushing);
-    if (pushing) ctx.island_pushing[static_cast<size_t>(island)] = 1;
-  }
-  for (ContactBatch& batch : g.batches) {
-    factorBatch(batch);
-    invertRowMasses(batch);
-  }
+  };
+  const int batch_count = static_cast<int>(g.batches.size());
+  if (w.pool_ && batch_count >= kParallelBatches) w.pool_->parallelFor(batch_count, fillBatches);
+  else fillBatches(0, batch_count);
+  for (size_t slot = 0; slot < ctx.lane_pushing.size(); ++slot)
+    if (ctx.lane_pushing[slot]) ctx.island_pushing[static_cast<size_t>(g.batches[slot / kBatchLanes].island[slot % kBatchLanes])] = 1;
 
   // 7. The other islands: generic rows island by island, joints first, then
   // all contact normal rows before any friction row (ODE's and Bullet's

@@ -113,6 +113,10 @@ struct StepContext {
   std::vector<std::int32_t> lane_contact;  // per batch lane (batch * 8 + lane): contact index, -1 padding
   std::vector<std::int32_t> group_joint;   // per row group: joint index, or -1 - contact index
   std::vector<char> island_pushing;        // per island: some contact deeper than the slop (being pushed out)
+  std::vector<std::vector<Contact>> pair_contacts;  // collide's threads: per thread, the contacts of its pairs
+  std::vector<std::vector<Manifold>> pair_manifolds;
+  std::vector<int> pair_recycled;
+  std::vector<char> lane_pushing;          // per batch lane: its contact is being pushed out (threads' scratch)
   // Scratch of the colouring.
   std::vector<GraphItem> items, sorted_items;
   std::vector<std::int32_t> colour_of, adj_start, adj, level, queue, level_start;

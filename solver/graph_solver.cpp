@@ -257,10 +257,11 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
       forColour(
           p.colours[static_cast<size_t>(ci)], o.pool, [&](std::int32_t gi) { solveGroup(p, gi, bodies, o, o.nncg); },
           [&](int b0, int b1) { o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, sp); });
-    for (const std::int32_t ci : p.colour_order)
-      forColour(
-          p.colours[static_cast<size_t>(ci)], o.pool, [](std::int32_t) {},
-          [&](int b0, int b1) { o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); });
+    if (!p.batches.empty())  // a jointed scene without contacts has no friction pass to walk
+      for (const std::int32_t ci : p.colour_order)
+        forColour(
+            p.colours[static_cast<size_t>(ci)], o.pool, [](std::int32_t) {},
+            [&](int b0, int b1) { o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); });
     reduceSweep(p, true);
     stats.last_max_delta = 0;
     for (size_t i = 0; i < p.island_active.size(); ++i)

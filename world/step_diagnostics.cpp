@@ -217,6 +217,12 @@ void addSupport(const WorldImpl& w, StepContext& ctx, const Contact& c, Real dep
   ctx.supports.push_back({sinks ? lower.index : -1, upper.index, stays});
 }
 
+// Contacts below which the watchers stay on the calling thread. A depth is
+// a few tens of nanoseconds, and a worker idle since the solve may have to
+// be woken: with 256, pile-1000's guards went from 0.08 to 0.14 ms/step on
+// two threads.
+constexpr int kParallelContacts = 4096;
+
 // Returns the deepest overlap of any contact (StepStats::max_penetration):
 // one pass over the contacts serves the statistic, the watcher and the
 // stack watcher's supports. A contact whose bodies cannot have moved keeps
@@ -227,14 +233,28 @@ Real watchPenetration(WorldImpl& w, StepContext& ctx) {
   const Real g = w.gravity_.norm();
   const Vec3 up = g > 0 ? Vec3(-w.gravity_ / g) : Vec3::Zero();
   ctx.supports.clear();
+  // The depths first, each contact on its own (on the pool's threads when
+  // there are many), then the reports in contact order.
+  const auto still = [&](const Contact& c) {
+    return stillThroughStep(w, ctx, c.body_a) && stillThroughStep(w, ctx, c.body_b);
+  };
+  const auto depths = [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      Contact& c = w.contacts_[static_cast<size_t>(i)];
+      if (c.enabled && !still(c)) c.depth_after = w.contactDepth(c);
+    }
+  };
+  const int count = static_cast<int>(w.contacts_.size());
+  if (w.pool_ && count >= kParallelContacts) w.pool_->parallelFor(count, depths);
+  else depths(0, count);
   Real deepest = 0;
   for (Contact& c : w.contacts_) {
     if (!c.enabled) continue;
-    if (stillThroughStep(w, ctx, c.body_a) && stillThroughStep(w, ctx, c.body_b)) {
+    if (still(c)) {
       deepest = std::max(deepest, c.depth_after);
       continue;
     }
-    const Real depth = c.depth_after = w.contactDepth(c);
+    const Real depth = c.depth_after;
     deepest = std::max(deepest, depth);
     if (g > 0) addSupport(w, ctx, c, depth, up);
     if (!(depth > tolerance)) continue;

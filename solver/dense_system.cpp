@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <type_traits>
 
 namespace cairn {
 
@@ -98,6 +99,95 @@ Real rowCoupling(const ConstraintRow& ri, const ConstraintRow& rj) {
     }
   }
   return s;
+}
+
+void assembleSparseLower(std::span<const ConstraintRow> rows, std::span<const int> subset, CfmOnDiagonal cfm,
+                         SparseAssembly& s, Eigen::SparseMatrix<double>& out) {
+  const int n = static_cast<int>(subset.size());
+  s.pos_of_row.assign(rows.size(), -1);
+  for (int k = 0; k < n; ++k) s.pos_of_row[static_cast<std::size_t>(subset[static_cast<std::size_t>(k)])] = k;
+  // Sides bucketed by body in row order, as assembleSparse does: the
+  // contributions below come in its triplet order, so each entry sums
+  // its terms in the same order and gets the same bits.
+  std::int32_t max_body = 0;
+  for (const ConstraintRow& r : rows) max_body = std::max({max_body, r.body_a, r.body_b});
+  s.bucket_start.assign(static_cast<std::size_t>(max_body) + 2, 0);
+  const auto forEachSide = [&](auto&& f) {
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      if (s.pos_of_row[r] < 0) continue;
+      if (const std::int32_t k = couplingBodyA(rows[r]); k != 0) f(k, static_cast<int>(r), false);
+      if (const std::int32_t k = couplingBodyB(rows[r]); k != 0) f(k, static_cast<int>(r), true);
+    }
+  };
+  forEachSide([&](std::int32_t k, int, bool) { ++s.bucket_start[static_cast<std::size_t>(k) + 1]; });
+  for (std::size_t k = 1; k < s.bucket_start.size(); ++k) s.bucket_start[k] += s.bucket_start[k - 1];
+  s.sides.resize(static_cast<std::size_t>(s.bucket_start.back()));
+  s.bucket_fill.assign(s.bucket_start.begin(), s.bucket_start.end() - 1);
+  forEachSide([&](std::int32_t k, int r, bool b) {
+    s.sides[static_cast<std::size_t>(s.bucket_fill[static_cast<std::size_t>(k)]++)] = {r, b};
+  });
+  const auto ref = [&](std::size_t p) {
+    const auto [r, b] = s.sides[p];
+    return SideRef{s.pos_of_row[static_cast<std::size_t>(r)], &rows[static_cast<std::size_t>(r)], b};
+  };
+
+  // Contributions (column = the smaller position) in triplet order, twice:
+  // once to count them per column (no values), once to place them.
+  const auto contributions = [&](auto values, auto&& add) {
+    constexpr bool kValues = decltype(values)::value;
+    const auto product = [&](const SideRef& a, const SideRef& b) { return kValues ? sideProduct(a, b) : 0.0; };
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const int pos = s.pos_of_row[r];
+      if (pos >= 0) add(pos, pos, cfm == CfmOnDiagonal::Include ? rows[r].cfm : 0.0);
+    }
+    for (std::size_t k = 0; k + 1 < s.bucket_start.size(); ++k) {
+      const auto begin = static_cast<std::size_t>(s.bucket_start[k]), end = static_cast<std::size_t>(s.bucket_start[k + 1]);
+      for (std::size_t p = begin; p < end; ++p) {
+        const SideRef sp = ref(p);
+        add(sp.pos, sp.pos, product(sp, sp));
+        for (std::size_t q = p + 1; q < end; ++q) {
+          const SideRef sq = ref(q);
+          if (sp.pos == sq.pos) add(sp.pos, sp.pos, product(sp, sq) + product(sq, sp));
+          else add(std::max(sp.pos, sq.pos), std::min(sp.pos, sq.pos), product(sp, sq));
+        }
+      }
+    }
+  };
+  s.column_start.assign(static_cast<std::size_t>(n) + 1, 0);
+  contributions(std::false_type{}, [&](int, int col, double) { ++s.column_start[static_cast<std::size_t>(col) + 1]; });
+  for (std::size_t c = 1; c < s.column_start.size(); ++c) s.column_start[c] += s.column_start[c - 1];
+  s.entries.resize(static_cast<std::size_t>(s.column_start.back()));
+  s.column_fill.assign(s.column_start.begin(), s.column_start.end() - 1);
+  contributions(std::true_type{}, [&](int row, int col, double v) {
+    s.entries[static_cast<std::size_t>(s.column_fill[static_cast<std::size_t>(col)]++)] = {row, v};
+  });
+
+  // Per column: rows ascending (a stable insertion sort keeps the order of
+  // equal rows), duplicates summed in that order, compacted in place.
+  int nnz = 0;
+  for (int c = 0; c < n; ++c) {
+    const int begin = s.column_start[static_cast<std::size_t>(c)], end = s.column_start[static_cast<std::size_t>(c) + 1];
+    SparseAssembly::Entry* e = s.entries.data();
+    for (int i = begin + 1; i < end; ++i) {
+      const SparseAssembly::Entry x = e[i];
+      int j = i;
+      for (; j > begin && e[j - 1].row > x.row; --j) e[j] = e[j - 1];
+      e[j] = x;
+    }
+    s.column_start[static_cast<std::size_t>(c)] = nnz;
+    for (int i = begin; i < end; ++i) {
+      if (i > begin && e[i].row == e[nnz - 1].row) e[nnz - 1].value += e[i].value;
+      else e[nnz++] = e[i];
+    }
+  }
+  s.column_start[static_cast<std::size_t>(n)] = nnz;
+  out.resize(n, n);
+  out.resizeNonZeros(nnz);
+  std::copy(s.column_start.begin(), s.column_start.end(), out.outerIndexPtr());
+  for (int i = 0; i < nnz; ++i) {
+    out.innerIndexPtr()[i] = s.entries[static_cast<std::size_t>(i)].row;
+    out.valuePtr()[i] = s.entries[static_cast<std::size_t>(i)].value;
+  }
 }
 
 Eigen::MatrixXd assembleDenseA(std::span<const ConstraintRow> rows, CfmOnDiagonal cfm) {

@@ -96,6 +96,26 @@ Eigen::SparseMatrix<double> assembleSparseA(std::span<const ConstraintRow> rows,
                                            std::span<const int> subset,
                                            CfmOnDiagonal cfm = CfmOnDiagonal::Exclude);
 
+// Scratch arrays of assembleSparseLower, kept by its caller so that a
+// steady scene assembles without allocating.
+struct SparseAssembly {
+  struct Entry {
+    int row;
+    double value;
+  };
+  std::vector<int> pos_of_row, bucket_start, bucket_fill, column_start, column_fill;
+  std::vector<std::pair<int, bool>> sides;  // (row, side b?) bucketed by body
+  std::vector<Entry> entries;
+};
+
+// The lower triangle of A[S, S] (+ cfm) written straight into `out`'s
+// compressed arrays, for a solver that reads one triangle (CHOLMOD with
+// Eigen::Lower): the same values, summed in the same order, as the lower
+// triangle of assembleSparseA, without the triplet list, its row-major
+// copy and the upper half.
+void assembleSparseLower(std::span<const ConstraintRow> rows, std::span<const int> subset, CfmOnDiagonal cfm,
+                         SparseAssembly& scratch, Eigen::SparseMatrix<double>& out);
+
 // Everything the mixed LCP needs, dense:
 //     w = A lambda + b,  lo <= lambda <= hi, complementarity (lcp_exact.hpp).
 // A includes cfm. For a friction row (normal_row[i] >= 0) lo/hi hold the

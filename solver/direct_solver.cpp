@@ -65,6 +65,8 @@ struct DirectSolver::Impl {
   std::vector<int> bilateral, unilateral;
   std::vector<Real> diag;
   Eigen::VectorXd rhs, delta;
+  SparseAssembly assembly;
+  SpMat abb;
 };
 
 DirectSolver::DirectSolver() : impl_(std::make_unique<Impl>()) {}
@@ -118,7 +120,9 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
   // Factor A_BB, reusing the symbolic analysis when the pattern is unchanged.
   bool have_factor = false;
   if (!s.bilateral.empty()) {
-    const SpMat abb = assembleSparseA(rows, s.bilateral, CfmOnDiagonal::Include);
+    // One triangle, as the factor reads it (Eigen::Lower), into reused arrays.
+    assembleSparseLower(rows, s.bilateral, CfmOnDiagonal::Include, s.assembly, s.abb);
+    const SpMat& abb = s.abb;
     std::vector<std::int32_t> key;
     key.reserve(2 * s.bilateral.size());
     for (int i : s.bilateral) {
@@ -191,7 +195,7 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
       }
     }
     ++st.outer_iterations;
-    st.residual_history.push_back(lcpResidual(rows, bodies, ResidualNorm::Max));
+    if (opt.report_residual) st.residual_history.push_back(lcpResidual(rows, bodies, ResidualNorm::Max));
     // Without unilateral rows one solve is exact, unless the shift made it
     // a proximal step that further solves refine.
     if (s.unilateral.empty() && !st.regularized) break;
@@ -200,7 +204,7 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
   // unilateral impulses (those keep the last PGS sweep's accuracy).
   if (!s.unilateral.empty()) solveBilateral();
   st.analysis_count = s.analysis_count;
-  st.residual = lcpResidual(rows, bodies, ResidualNorm::Max);
+  if (opt.report_residual) st.residual = lcpResidual(rows, bodies, ResidualNorm::Max);
   return st;
 }
 

@@ -51,6 +51,9 @@ struct DirectSolverOptions {
   // (PGS's applyWarmStart ran). Otherwise the solver adds the warm-start
   // impulse itself. Either way the result is v = v* + M^-1 J^T lambda.
   bool velocities_include_lambda = false;
+  // Fill DirectSolveStats::residual and residual_history (a pass over the
+  // rows each; the step's callers measure what they need themselves).
+  bool report_residual = true;
 };
 
 struct DirectSolveStats {

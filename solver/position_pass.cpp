@@ -24,6 +24,7 @@ PositionPassStats solvePositionPass(DirectSolver& solver, std::vector<Constraint
   DirectSolverOptions d;
   d.outer_iterations = 1;  // bilateral rows only: one exact solve
   d.warm_start = false;    // a correction from zero, never last step's
+  d.report_residual = false;  // the pass measures its own error
   std::vector<SolverBody> back;
   while (st.iterations < options.max_iterations && st.error_after > options.tolerance) {
     std::fill(bodies.begin(), bodies.end(), SolverBody{});

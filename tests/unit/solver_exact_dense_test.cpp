@@ -69,6 +69,32 @@ TEST(DenseSystem, SparseAssemblyEqualsDenseAssembly) {
   }
 }
 
+// The direct solver's one-triangle assembly is the lower triangle of the
+// full one, bit for bit (the same terms summed in the same order), with the
+// same pattern (every diagonal stored), whatever rows it is given and in
+// whichever order; and it reuses its scratch across calls.
+TEST(DenseSystem, LowerAssemblyIsTheFullAssemblysLowerTriangleExactly) {
+  std::mt19937 rng(12);
+  const RowSystem s = mixedSystem(rng);
+  SparseAssembly scratch;
+  Eigen::SparseMatrix<double> lower;
+  std::vector<int> all(s.rows.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  for (CfmOnDiagonal cfm : {CfmOnDiagonal::Exclude, CfmOnDiagonal::Include})
+    for (const std::vector<int>& subset : {all, std::vector<int>{7, 2, 0, 11, 5, 16, 3}}) {
+      const Eigen::SparseMatrix<double> full = assembleSparseA(s.rows, subset, cfm);
+      assembleSparseLower(s.rows, subset, cfm, scratch, lower);
+      EXPECT_TRUE(lower.isCompressed());
+      const Eigen::SparseMatrix<double> expect = full.triangularView<Eigen::Lower>();
+      ASSERT_EQ(lower.nonZeros(), expect.nonZeros());
+      for (Eigen::Index k = 0; k < expect.nonZeros(); ++k) {
+        EXPECT_EQ(lower.innerIndexPtr()[k], expect.innerIndexPtr()[k]);
+        EXPECT_EQ(lower.valuePtr()[k], expect.valuePtr()[k]);
+      }
+      for (Eigen::Index c = 0; c <= expect.cols(); ++c) EXPECT_EQ(lower.outerIndexPtr()[c], expect.outerIndexPtr()[c]);
+    }
+}
+
 // Rows that share only the world or a zero-mass body do not couple: the
 // sparse pattern holds their diagonals only, and a row naming the same body
 // on both sides gets (J_a + J_b) M^-1 (J_a + J_b)^T.

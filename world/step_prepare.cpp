@@ -556,8 +556,11 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   const int batch_count = static_cast<int>(g.batches.size());
   if (w.pool_ && batch_count >= kParallelBatches) w.pool_->parallelFor(batch_count, fillBatches);
   else fillBatches(0, batch_count);
-  for (size_t slot = 0; slot < ctx.lane_pushing.size(); ++slot)
-    if (ctx.lane_pushing[slot]) ctx.island_pushing[static_cast<size_t>(g.batches[slot / kBatchLanes].island[slot % kBatchLanes])] = 1;
+  for (size_t slot = 0; slot < ctx.lane_pushing.size(); ++slot) {
+    if (!ctx.lane_pushing[slot]) continue;
+    const std::int32_t island = g.batches[slot / kBatchLanes].island[slot % kBatchLanes];
+    ctx.island_pushing[static_cast<size_t>(island)] = 1;
+  }
 
   // 7. The other islands: generic rows island by island, joints first, then
   // all contact normal rows before any friction row (ODE's and Bullet's

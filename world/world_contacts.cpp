@@ -204,6 +204,7 @@ bool pairsAtRest(const WorldImpl& w) {
   }
   return true;
 }
+
 // One candidate pair (broadphase handles pa, pb): its contacts appended to
 // `out`, last step's kept as they were when neither body moves, else a
 // recycled manifold, else the narrowphase's. Reads the world only (the
@@ -211,8 +212,7 @@ bool pairsAtRest(const WorldImpl& w) {
 // whether a manifold was recycled.
 bool collidePair(const WorldImpl& w, int pa, int pb, Real h, Real cos_half_angle, std::vector<Manifold>& manifolds,
                  std::vector<Contact>& out) {
-  const SolverSettings& settings_ = w.settings_;
-  const std::vector<Contact>& old_contacts_ = w.old_contacts_;
+  const std::vector<Contact>& old = w.old_contacts_;
   std::int32_t sa = w.broadphase_.user(pa), sb = w.broadphase_.user(pb);
   if (sa > sb) std::swap(sa, sb);
   const ShapeRef& ra = w.shapes_[static_cast<size_t>(sa)];
@@ -226,19 +226,19 @@ bool collidePair(const WorldImpl& w, int pa, int pb, Real h, Real cos_half_angle
   probe.shape_a = sa;
   probe.shape_b = sb;
   probe.triangle = -1;
-  const auto cached = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), probe.key(),
+  const auto cached = std::lower_bound(old.begin(), old.end(), probe.key(),
                                        [](const Contact& x, std::uint64_t k) { return x.key() < k; });
   if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were
-    for (auto it = cached; it != old_contacts_.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
+    for (auto it = cached; it != old.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
       out.push_back(*it);
       out.back().carried = true;
     }
     return false;
   }
-  if (recycleManifold(w, ba, bb, sa, sb, cached, old_contacts_, cos_half_angle, out)) return true;
+  if (recycleManifold(w, ba, bb, sa, sb, cached, old, cos_half_angle, out)) return true;
   const ShapeDesc& sda = ba.shapes[static_cast<size_t>(ra.index)];
   const ShapeDesc& sdb = bb.shapes[static_cast<size_t>(rb.index)];
-  const Real margin = std::max(reach(ba, settings_.contact_margin, h), reach(bb, settings_.contact_margin, h));
+  const Real margin = std::max(reach(ba, w.settings_.contact_margin, h), reach(bb, w.settings_.contact_margin, h));
   manifolds.clear();
   cairn::collide(sda, ba.transform() * sda.local, sdb, bb.transform() * sdb.local, margin, manifolds);
   for (const Manifold& m : manifolds) {

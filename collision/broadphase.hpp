@@ -29,9 +29,8 @@
 // group meets the other's mask, the rule of Bullet's
 // btOverlapFilterCallback (m_collisionFilterGroup / m_collisionFilterMask)
 // and Box2D's b2ShouldShapesCollide, applied where the pair is found: a
-// chain whose links never collide with each other then makes no pairs to
-// sort and test (chain-100's broadphase did a third of its collide stage
-// on pairs the narrowphase threw away).
+// chain whose links never collide with each other makes no pairs to sort,
+// keep and hand to the narrowphase only to be thrown away there.
 //
 // Bounded pairs: one proxy's query stops after max_pairs_per_proxy other
 // proxies (setMaxPairsPerProxy), so the pair list holds at most that many

@@ -23,67 +23,6 @@ const Vec3& mAng(const SideRef& s) { return s.side_b ? s.row->m_ang_b : s.row->m
 
 Real sideProduct(const SideRef& i, const SideRef& j) { return jLin(i).dot(mLin(j)) + jAng(i).dot(mAng(j)); }
 
-// Builds A[S, S] where pos_of_row[r] is row r's position in S or -1.
-Eigen::SparseMatrix<double> assembleSparse(std::span<const ConstraintRow> rows, const std::vector<int>& pos_of_row,
-                                           int n, CfmOnDiagonal cfm) {
-  // Bucket the moving sides by body (counting sort: one pass to count, one
-  // to place), so that only rows sharing a body are ever paired.
-  std::int32_t max_body = 0;
-  for (const ConstraintRow& r : rows) max_body = std::max({max_body, r.body_a, r.body_b});
-  std::vector<int> start(static_cast<std::size_t>(max_body) + 2, 0);
-  auto forEachSide = [&](auto&& f) {
-    for (std::size_t r = 0; r < rows.size(); ++r) {
-      const int pos = pos_of_row[r];
-      if (pos < 0) continue;
-      const ConstraintRow& row = rows[r];
-      if (const std::int32_t k = couplingBodyA(row); k != 0) f(k, SideRef{pos, &row, false});
-      if (const std::int32_t k = couplingBodyB(row); k != 0) f(k, SideRef{pos, &row, true});
-    }
-  };
-  forEachSide([&](std::int32_t k, const SideRef&) { ++start[static_cast<std::size_t>(k) + 1]; });
-  for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
-  std::vector<SideRef> sides(static_cast<std::size_t>(start.back()));
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  forEachSide([&](std::int32_t k, const SideRef& s) { sides[static_cast<std::size_t>(fill[static_cast<std::size_t>(k)]++)] = s; });
-
-  std::vector<Eigen::Triplet<double>> triplets;
-  std::size_t count = static_cast<std::size_t>(n);
-  for (std::size_t k = 0; k + 1 < start.size(); ++k) {
-    const auto deg = static_cast<std::size_t>(start[k + 1] - start[k]);
-    count += deg * deg;
-  }
-  triplets.reserve(count);
-
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const int pos = pos_of_row[r];
-    if (pos >= 0) triplets.emplace_back(pos, pos, cfm == CfmOnDiagonal::Include ? rows[r].cfm : 0.0);
-  }
-  for (std::size_t k = 0; k + 1 < start.size(); ++k) {
-    const int begin = start[k], end = start[k + 1];
-    for (int p = begin; p < end; ++p) {
-      const SideRef& sp = sides[static_cast<std::size_t>(p)];
-      triplets.emplace_back(sp.pos, sp.pos, sideProduct(sp, sp));
-      for (int q = p + 1; q < end; ++q) {
-        const SideRef& sq = sides[static_cast<std::size_t>(q)];
-        if (sp.pos == sq.pos) {
-          // Both sides of one row on the same body: the cross terms of
-          // (J_a + J_b) M^-1 (J_a + J_b)^T.
-          triplets.emplace_back(sp.pos, sp.pos, sideProduct(sp, sq) + sideProduct(sq, sp));
-        } else {
-          // One value for both triangles keeps A exactly symmetric.
-          const double v = sideProduct(sp, sq);
-          triplets.emplace_back(sp.pos, sq.pos, v);
-          triplets.emplace_back(sq.pos, sp.pos, v);
-        }
-      }
-    }
-  }
-  Eigen::SparseMatrix<double> a(n, n);
-  a.setFromTriplets(triplets.begin(), triplets.end());  // sums duplicates, keeps explicit zeros
-  a.makeCompressed();
-  return a;
-}
-
 }  // namespace
 
 Real rowCoupling(const ConstraintRow& ri, const ConstraintRow& rj) {
@@ -106,9 +45,8 @@ void assembleSparseLower(std::span<const ConstraintRow> rows, std::span<const in
   const int n = static_cast<int>(subset.size());
   s.pos_of_row.assign(rows.size(), -1);
   for (int k = 0; k < n; ++k) s.pos_of_row[static_cast<std::size_t>(subset[static_cast<std::size_t>(k)])] = k;
-  // Sides bucketed by body in row order, as assembleSparse does: the
-  // contributions below come in its triplet order, so each entry sums
-  // its terms in the same order and gets the same bits.
+  // Sides bucketed by body in row order (a counting sort: one pass to
+  // count, one to place), so that only rows sharing a body are ever paired.
   std::int32_t max_body = 0;
   for (const ConstraintRow& r : rows) max_body = std::max({max_body, r.body_a, r.body_b});
   s.bucket_start.assign(static_cast<std::size_t>(max_body) + 2, 0);
@@ -131,8 +69,8 @@ void assembleSparseLower(std::span<const ConstraintRow> rows, std::span<const in
     return SideRef{s.pos_of_row[static_cast<std::size_t>(r)], &rows[static_cast<std::size_t>(r)], b};
   };
 
-  // Contributions (column = the smaller position) in triplet order, twice:
-  // once to count them per column (no values), once to place them.
+  // Contributions (column = the smaller position), in a fixed order,
+  // twice: once to count them per column (no values), once to place them.
   const auto contributions = [&](auto values, auto&& add) {
     constexpr bool kValues = decltype(values)::value;
     const auto product = [&](const SideRef& a, const SideRef& b) { return kValues ? sideProduct(a, b) : 0.0; };
@@ -210,16 +148,21 @@ Eigen::VectorXd assembleB(std::span<const ConstraintRow> rows, std::span<const S
 }
 
 Eigen::SparseMatrix<double> assembleSparseA(std::span<const ConstraintRow> rows, CfmOnDiagonal cfm) {
-  std::vector<int> pos(rows.size());
-  for (std::size_t i = 0; i < rows.size(); ++i) pos[i] = static_cast<int>(i);
-  return assembleSparse(rows, pos, static_cast<int>(rows.size()), cfm);
+  std::vector<int> all(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) all[i] = static_cast<int>(i);
+  return assembleSparseA(rows, all, cfm);
 }
 
+// Both triangles: the lower one mirrored, so A is exactly symmetric and
+// keeps every stored entry (explicit zeros on the diagonal included).
 Eigen::SparseMatrix<double> assembleSparseA(std::span<const ConstraintRow> rows, std::span<const int> subset,
                                            CfmOnDiagonal cfm) {
-  std::vector<int> pos(rows.size(), -1);
-  for (std::size_t k = 0; k < subset.size(); ++k) pos[static_cast<std::size_t>(subset[k])] = static_cast<int>(k);
-  return assembleSparse(rows, pos, static_cast<int>(subset.size()), cfm);
+  SparseAssembly scratch;
+  Eigen::SparseMatrix<double> lower;
+  assembleSparseLower(rows, subset, cfm, scratch, lower);
+  Eigen::SparseMatrix<double> full = lower.selfadjointView<Eigen::Lower>();
+  full.makeCompressed();
+  return full;
 }
 
 DenseLcp assembleDenseLcp(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {

@@ -110,9 +110,9 @@ struct SparseAssembly {
 
 // The lower triangle of A[S, S] (+ cfm) written straight into `out`'s
 // compressed arrays, for a solver that reads one triangle (CHOLMOD with
-// Eigen::Lower): the same values, summed in the same order, as the lower
-// triangle of assembleSparseA, without the triplet list, its row-major
-// copy and the upper half.
+// Eigen::Lower): no triplet list, no row-major copy, no upper half, and no
+// allocation once `scratch` has grown. Same pattern guarantees as below;
+// assembleSparseA mirrors it.
 void assembleSparseLower(std::span<const ConstraintRow> rows, std::span<const int> subset, CfmOnDiagonal cfm,
                          SparseAssembly& scratch, Eigen::SparseMatrix<double>& out);
 

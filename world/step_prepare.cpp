@@ -115,7 +115,7 @@ struct ContactParams {
 
 // One manifold into one lane (contact_batch.hpp lists the fields).
 void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a, const BodyView& b,
-              std::int32_t island, const ContactParams& cp, bool& pushing) {
+              std::int32_t island, const ContactParams& cp) {
   batch.body_a[lane] = a.solver_index;
   batch.body_b[lane] = b.solver_index;
   batch.island[lane] = island;
@@ -176,8 +176,7 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
       // Every point of the manifold takes part in the correction pass
       // (target 0 within the slop, -gap/h while separated), so pushing one
       // corner out lifts the body instead of tipping it.
-      q.bias[lane] = sep > 0 ? -sep / cp.h : push;
-      pushing = pushing || push > 0;
+      q.bias[lane] = sep > 0 ? -sep / cp.h : push;  // > 0: being pushed out
     }
     q.rhs[lane] = rhs;
     // Restitution: the approach speed at detection, before this step's
@@ -231,8 +230,7 @@ void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a
 void padLane(ContactBatch& batch, int lane) {
   Contact none;
   none.count = 0;
-  bool pushing = false;
-  fillLane(batch, lane, none, BodyView{}, BodyView{}, 0, ContactParams{}, pushing);
+  fillLane(batch, lane, none, BodyView{}, BodyView{}, 0, ContactParams{});
 }
 
 }  // namespace
@@ -530,24 +528,19 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   // eight times, which made this loop a fifth of an awake pyramid's step.
   // Each batch is filled and factored on its own, so the batches are split
   // among the pool's threads when there are enough of them (a batch is
-  // about a microsecond of work, as much as handing a loop over); which
-  // island pushes is gathered afterwards, in storage order.
-  ctx.lane_pushing.assign(ctx.lane_contact.size(), 0);
+  // about a microsecond of work, as much as handing a loop over).
   const auto fillBatches = [&](int begin, int end) {
     for (int bi = begin; bi < end; ++bi) {
       ContactBatch& batch = g.batches[static_cast<size_t>(bi)];
       for (int lane = 0; lane < kBatchLanes; ++lane) {
-        const size_t slot = static_cast<size_t>(bi) * kBatchLanes + static_cast<size_t>(lane);
-        const std::int32_t ci = ctx.lane_contact[slot];
+        const std::int32_t ci = ctx.lane_contact[static_cast<size_t>(bi) * kBatchLanes + static_cast<size_t>(lane)];
         if (ci < 0) {  // the rest of a colour's last batch
           padLane(batch, lane);
           continue;
         }
         const Contact& con = w.contacts_[static_cast<size_t>(ci)];
-        bool pushing = false;
         fillLane(batch, lane, con, solverView(w, ctx, con.body_a), solverView(w, ctx, con.body_b), batch.island[lane],
-                 cp, pushing);
-        ctx.lane_pushing[slot] = pushing;
+                 cp);
       }
       factorBatch(batch);
       invertRowMasses(batch);
@@ -556,11 +549,13 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   const int batch_count = static_cast<int>(g.batches.size());
   if (w.pool_ && batch_count >= kParallelBatches) w.pool_->parallelFor(batch_count, fillBatches);
   else fillBatches(0, batch_count);
-  for (size_t slot = 0; slot < ctx.lane_pushing.size(); ++slot) {
-    if (!ctx.lane_pushing[slot]) continue;
-    const std::int32_t island = g.batches[slot / kBatchLanes].island[slot % kBatchLanes];
-    ctx.island_pushing[static_cast<size_t>(island)] = 1;
-  }
+  // Which islands push out, from the lanes' correction targets (a target
+  // above zero is a push; padding and InRhs lanes have none), in storage
+  // order.
+  for (const ContactBatch& batch : g.batches)
+    for (int lane = 0; lane < kBatchLanes; ++lane)
+      for (int i = 0; i < batch.count[lane]; ++i)
+        if (batch.p[i].bias[lane] > 0) ctx.island_pushing[static_cast<size_t>(batch.island[lane])] = 1;
 
   // 7. The other islands: generic rows island by island, joints first, then
   // all contact normal rows before any friction row (ODE's and Bullet's

@@ -319,6 +319,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
       return recycled;
     };
     const int pair_count = static_cast<int>(w.pairs_.size());
+    if (ctx.pair_manifolds.empty()) ctx.pair_manifolds.resize(1);  // the calling thread's scratch
     // The pairs are independent: split among the pool's threads, each
     // appending to its own list, the lists joined in pair order (the same
     // contacts in the same order whatever the split). The user's filter
@@ -339,7 +340,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
         w.stats_.recycled_contacts += ctx.pair_recycled[t];
       }
     } else {
-      w.stats_.recycled_contacts += pairRange(0, pair_count, contacts_, w.manifolds_);
+      w.stats_.recycled_contacts += pairRange(0, pair_count, contacts_, ctx.pair_manifolds[0]);
     }
     // Contacts in key order (deterministic, and for the lookup below). The
     // broadphase hands pairs over in a stable order, so this is usually
@@ -375,7 +376,8 @@ void collide(WorldImpl& w, StepContext& ctx) {
       }
     }
   };
-  // Each contact reads last step's list and writes only itself.
+  // Each contact reads last step's list and writes only itself; a match is
+  // about as cheap as a recycled pair, so the pairs' threshold serves.
   const int contact_count = static_cast<int>(contacts_.size());
   const auto warmRange = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) warmStart(contacts_[static_cast<size_t>(i)]);

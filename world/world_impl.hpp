@@ -114,9 +114,8 @@ struct StepContext {
   std::vector<std::int32_t> group_joint;   // per row group: joint index, or -1 - contact index
   std::vector<char> island_pushing;        // per island: some contact deeper than the slop (being pushed out)
   std::vector<std::vector<Contact>> pair_contacts;  // collide's threads: per thread, the contacts of its pairs
-  std::vector<std::vector<Manifold>> pair_manifolds;
+  std::vector<std::vector<Manifold>> pair_manifolds;  // per thread, narrowphase scratch ([0]: the calling thread)
   std::vector<int> pair_recycled;
-  std::vector<char> lane_pushing;          // per batch lane: its contact is being pushed out (threads' scratch)
   // Scratch of the colouring.
   std::vector<GraphItem> items, sorted_items;
   std::vector<std::int32_t> colour_of, adj_start, adj, level, queue, level_start;
@@ -298,7 +297,6 @@ class WorldImpl {
   std::vector<Contact> old_contacts_;  // scratch: last step's, for matching
   std::vector<Contact> ended_contacts_;  // touching contacts removed with a body or shape between steps
   std::vector<std::pair<int, int>> pairs_;
-  std::vector<Manifold> manifolds_;
   std::vector<ContactEvent> contact_events_;
   ContactCallback contact_callback_;
   World::CollisionFilter filter_callback_;

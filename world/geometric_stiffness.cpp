@@ -62,7 +62,6 @@ Mat3 stiffness(const Vec3& f, const Vec3& r) { return f.dot(r) * Mat3::Identity(
 }  // namespace
 
 void stiffenRotations(WorldImpl& w, StepContext& ctx) {
-  ctx.stiffness.assign(w.bodies_.size(), Mat3::Zero());
   ctx.any_stiffness = false;
   if (!w.settings_.geometric_stiffness) return;
   for (const Joint& j : w.joints_) {
@@ -72,6 +71,10 @@ void stiffenRotations(WorldImpl& w, StepContext& ctx) {
       if (id.isWorld() || !stiffened(ctx, ctx.body_island[static_cast<size_t>(id.index)])) continue;
       const Body& b = w.bodies_[static_cast<size_t>(id.index)];
       if (b.rotation_locked) continue;
+      // Zeroed at the first joint that adds to it (a scene without joints
+      // does not clear 72 bytes per body every substep); read only when
+      // any_stiffness is set.
+      if (!ctx.any_stiffness) ctx.stiffness.assign(w.bodies_.size(), Mat3::Zero());
       ctx.stiffness[static_cast<size_t>(id.index)] += stiffness(f, b.orientation * local);
       ctx.any_stiffness = true;
     }

@@ -63,18 +63,32 @@ void WorldImpl::wakeBody(BodyId id) {
 
 void buildIslands(WorldImpl& w, StepContext& ctx) {
   const auto n = static_cast<std::int32_t>(w.bodies_.size());
-  const auto movable = [&](BodyId id) { return !id.isWorld() && w.body(id).isDynamic(); };
+  // What the stage asks of each body, read once into a byte per slot: the
+  // contact and joint loops below then look bodies up in this compact
+  // array, not in the bodies themselves (a sleeping pile's islands stage
+  // was mostly those lookups).
+  enum : std::uint8_t { kAlive = 1, kDynamic = 2, kKinematic = 4, kAsleep = 8, kKinematicMoving = 16 };
+  std::vector<std::uint8_t>& flags = ctx.body_flags;
+  flags.assign(static_cast<size_t>(n), 0);
+  for (size_t i = 0; i < flags.size(); ++i) {
+    const Body& b = w.bodies_[i];
+    std::uint8_t f = b.alive ? kAlive : 0;
+    if (b.isDynamic()) f |= kDynamic;
+    if (b.type == BodyType::Kinematic) f |= kKinematic;
+    if (b.asleep) f |= kAsleep;
+    if (kinematicMoving(b)) f |= kKinematicMoving;
+    flags[i] = f;
+  }
+  const auto has = [&](BodyId id, std::uint8_t bit) { return !id.isWorld() && (flags[static_cast<size_t>(id.index)] & bit); };
   const auto moving = [&](BodyId id) {
-    if (id.isWorld()) return false;
-    const Body& b = w.body(id);
-    return kinematicMoving(b) || (b.isDynamic() && !b.asleep);
+    return has(id, kKinematicMoving) || (has(id, kDynamic) && !has(id, kAsleep));
   };
   // Wake sleeping islands touched by something that moves: gather the
   // islands first, then wake them in one pass over the bodies.
   std::vector<std::int32_t>& to_wake = ctx.wake_list;
   to_wake.clear();
   const auto touch = [&](BodyId sleeper, BodyId other) {
-    if (sleeper.isWorld() || !w.body(sleeper).asleep || !moving(other)) return;
+    if (!has(sleeper, kAsleep) || !moving(other)) return;
     w.body(sleeper).sleep_timer = 0;
     to_wake.push_back(w.sleep_island_[static_cast<size_t>(sleeper.index)]);
   };
@@ -91,30 +105,41 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
   if (!to_wake.empty()) {
     std::sort(to_wake.begin(), to_wake.end());
     for (size_t i = 0; i < w.bodies_.size(); ++i) {
+      if ((flags[i] & (kAlive | kAsleep)) != (kAlive | kAsleep) ||
+          !std::binary_search(to_wake.begin(), to_wake.end(), w.sleep_island_[i]))
+        continue;
       Body& b = w.bodies_[i];
-      if (!b.alive || !b.asleep || !std::binary_search(to_wake.begin(), to_wake.end(), w.sleep_island_[i])) continue;
       b.asleep = false;
       b.sleep_timer = 0;
       w.sleep_island_[i] = -1;
+      flags[i] &= static_cast<std::uint8_t>(~kAsleep);
     }
   }
 
   ctx.uf_parent.resize(static_cast<size_t>(n));
   for (std::int32_t i = 0; i < n; ++i) ctx.uf_parent[static_cast<size_t>(i)] = i;
   for (const Contact& c : w.contacts_)
-    if (c.enabled && movable(c.body_a) && movable(c.body_b)) unite(ctx.uf_parent, c.body_a.index, c.body_b.index);
+    if (c.enabled && has(c.body_a, kDynamic) && has(c.body_b, kDynamic))
+      unite(ctx.uf_parent, c.body_a.index, c.body_b.index);
   for (const Joint& j : w.joints_)
-    if (j.alive && !j.broken && movable(j.def.body_a) && movable(j.def.body_b))
+    if (j.alive && !j.broken && has(j.def.body_a, kDynamic) && has(j.def.body_b, kDynamic))
       unite(ctx.uf_parent, j.def.body_a.index, j.def.body_b.index);
 
-  // Number the islands of awake dynamic bodies in body order.
+  // Number the islands of awake dynamic bodies in body order. The same
+  // walk lists the kinematic bodies and counts the sleepers, so that no
+  // later stage has to read every body for them.
   ctx.body_island.assign(static_cast<size_t>(n), -1);
   std::vector<std::int32_t>& island_of_root = ctx.island_root;
   island_of_root.assign(static_cast<size_t>(n), -1);
   ctx.island_count = 0;
+  ctx.kinematic_bodies.clear();
+  ctx.asleep_bodies = 0;
   for (std::int32_t i = 0; i < n; ++i) {
-    const Body& b = w.bodies_[static_cast<size_t>(i)];
-    if (!b.alive || !b.isDynamic() || b.asleep) continue;
+    const std::uint8_t f = flags[static_cast<size_t>(i)];
+    if (!(f & kAlive)) continue;
+    if (f & kAsleep) ++ctx.asleep_bodies;
+    if (f & kKinematic) ctx.kinematic_bodies.push_back(i);
+    if (!(f & kDynamic) || (f & kAsleep)) continue;
     std::int32_t& isl = island_of_root[static_cast<size_t>(findRoot(ctx.uf_parent, i))];
     if (isl < 0) isl = ctx.island_count++;
     ctx.body_island[static_cast<size_t>(i)] = isl;
@@ -197,13 +222,14 @@ void updateSleep(WorldImpl& w, StepContext& ctx) {
       if (isl >= 0) island_min[static_cast<size_t>(isl)] = 0;
     }
     // An island touching a moving kinematic body stays awake.
-    for (const Contact& c : w.contacts_) {
-      for (const auto& [kin, dyn] : {std::pair{c.body_a, c.body_b}, std::pair{c.body_b, c.body_a}}) {
-        if (kin.isWorld() || dyn.isWorld() || !kinematicMoving(w.body(kin))) continue;
-        const std::int32_t isl = ctx.body_island[static_cast<size_t>(dyn.index)];
-        if (isl >= 0) island_min[static_cast<size_t>(isl)] = 0;
+    if (!ctx.kinematic_bodies.empty())
+      for (const Contact& c : w.contacts_) {
+        for (const auto& [kin, dyn] : {std::pair{c.body_a, c.body_b}, std::pair{c.body_b, c.body_a}}) {
+          if (kin.isWorld() || dyn.isWorld() || !kinematicMoving(w.body(kin))) continue;
+          const std::int32_t isl = ctx.body_island[static_cast<size_t>(dyn.index)];
+          if (isl >= 0) island_min[static_cast<size_t>(isl)] = 0;
+        }
       }
-    }
     // A sleeping island is remembered by its first body's index, so waking
     // any of its bodies wakes all of them.
     std::vector<std::int32_t>& first = ctx.sleep_first;
@@ -212,6 +238,7 @@ void updateSleep(WorldImpl& w, StepContext& ctx) {
       const std::int32_t isl = ctx.body_island[i];
       if (isl < 0 || island_min[static_cast<size_t>(isl)] < s.sleep_time) continue;
       Body& b = w.bodies_[i];
+      if (!b.asleep) ++sleeping;
       b.asleep = true;
       b.linear_velocity.setZero();
       b.angular_velocity.setZero();
@@ -219,8 +246,9 @@ void updateSleep(WorldImpl& w, StepContext& ctx) {
       w.sleep_island_[i] = first[static_cast<size_t>(isl)];
     }
   }
-  for (const Body& b : w.bodies_) sleeping += (b.alive && b.asleep) ? 1 : 0;
-  w.stats_.sleeping_bodies = sleeping;
+  // Those asleep since the islands stage (nothing wakes a body after it)
+  // and those put to sleep just now.
+  w.stats_.sleeping_bodies = ctx.asleep_bodies + sleeping;
 }
 
 void WorldImpl::putIslandToSleep(BodyId id) {

@@ -592,6 +592,14 @@ void ioWorld(Ar& ar, WorldImpl& w) {
   });
   io(ar, w.ctx_.joint_error_last);
   ioEach(ar, w.ctx_.joint_drift_run, [&ar](std::uint8_t& x) { ar(x); });
+  if constexpr (Ar::reading) {
+    // Forces restored for the coming step are cleared after it, as the
+    // API's are (world/world_step.cpp).
+    w.forced_bodies_.clear();
+    for (size_t i = 0; i < w.bodies_.size(); ++i)
+      if (w.bodies_[i].force != Vec3::Zero() || w.bodies_[i].torque != Vec3::Zero())
+        w.forced_bodies_.push_back(static_cast<std::int32_t>(i));
+  }
 }
 
 }  // namespace

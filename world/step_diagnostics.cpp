@@ -106,43 +106,17 @@ Real springEnergyAt(const WorldImpl& w, const Spring& s, const StepContext* star
                       s.def.stiffness);
 }
 
-// Whether a body cannot have moved in this step: asleep when it began and
-// still asleep, or static (kinematic bodies move).
-bool stillThroughStep(const WorldImpl& w, const StepContext& ctx, BodyId id) {
-  if (id.isWorld()) return true;
-  const Body& b = w.body(id);
-  if (b.type == BodyType::Static) return true;
-  return b.isDynamic() && b.asleep && ctx.step_start[static_cast<size_t>(id.index)].asleep;
-}
+// Whether a body can have moved in this step (the world cannot).
+bool movedInStep(const StepContext& ctx, BodyId id) { return !id.isWorld() && ctx.moves(static_cast<size_t>(id.index)); }
 
-// T + V at the step's start (from ctx.step_start) or now, of the bodies that
-// may have moved in the step (`moved`), or of those that cannot have
-// (`!moved`: the same at both ends, so left out of the step's change).
-Real energy(const WorldImpl& w, const StepContext& ctx, bool at_start, bool moved) {
-  Real e = 0;
-  for (size_t i = 0; i < w.bodies_.size(); ++i) {
-    const Body& b = w.bodies_[i];
-    if (!b.alive || !b.isDynamic()) continue;
-    if (stillThroughStep(w, ctx, w.bodyId(static_cast<int>(i))) == moved) continue;
-    if (!at_start) {
-      e += b.kineticEnergy() - b.mass * w.gravity_.dot(b.position);
-      continue;
-    }
-    const StepContext::SavedState& st = ctx.step_start[i];
-    const Mat3 r = st.q.toRotationMatrix();
-    e += Real(0.5) * b.mass * st.v.squaredNorm() + Real(0.5) * st.w.dot(r * (b.inertia_body * (r.transpose() * st.w))) -
-         b.mass * w.gravity_.dot(st.x);
-  }
-  if (moved)
-    for (const Spring& s : w.springs_)
-      if (s.alive) e += springEnergyAt(w, s, at_start ? &ctx : nullptr);
-  return e;
-}
-
-// Whether anything outside the bodies did work on them this step.
+// Whether anything outside the bodies did work on them this step. A body
+// pushed so (a constant force, a timed impulse) was woken by it, and a
+// kinematic body always moves in the step: only those can have.
 bool externalWork(const WorldImpl& w, const StepContext& ctx) {
   if (w.external_forces_) return true;
-  for (const Body& b : w.bodies_) {
+  for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    if (!ctx.moves(i)) continue;
+    const Body& b = w.bodies_[i];
     if (!b.alive) continue;
     if (b.type == BodyType::Kinematic && b.linear_velocity.squaredNorm() + b.angular_velocity.squaredNorm() > 0)
       return true;
@@ -156,24 +130,44 @@ bool externalWork(const WorldImpl& w, const StepContext& ctx) {
   return false;
 }
 
+// E = T + V at the step's start and end, in one pass in body order. The
+// bodies that moved (StepContext::moves) are summed at both ends (their
+// start from ctx.start_energy); the others, whose energy did not change,
+// once, from ctx.start_energy: a sleeping body is not read at all.
 void watchEnergy(WorldImpl& w, StepContext& ctx) {
-  const Real before = energy(w, ctx, true, true);
-  const Real after = energy(w, ctx, false, true);
-  w.stats_.energy = after + energy(w, ctx, false, false);
+  const bool watch = !externalWork(w, ctx);
+  Real before = 0, after = 0, still = 0, scale = 0;
+  if (watch)
+    for (const Spring& s : w.springs_)
+      if (s.alive) scale += springEnergyAt(w, s, nullptr);
+  const Real g = w.gravity_.norm();
+  for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    if (!ctx.moves(i)) {
+      still += ctx.start_energy[i];  // 0 for a body that is not dynamic
+      continue;
+    }
+    const Body& b = w.bodies_[i];
+    if (!b.alive || !b.isDynamic()) continue;
+    const Real kinetic = b.kineticEnergy();
+    before += ctx.start_energy[i];
+    after += kinetic - b.mass * w.gravity_.dot(b.position);
+    // The energy scale: what is in motion, and the work to lift each awake
+    // body by its radius of gyration.
+    if (watch && !b.asleep)
+      scale += kinetic + b.mass * g * std::sqrt(std::max(Real(0), b.inertia_body.trace() / (2 * b.mass)));
+  }
+  for (const Spring& s : w.springs_)
+    if (s.alive) {
+      before += springEnergyAt(w, s, &ctx);
+      after += springEnergyAt(w, s, nullptr);
+    }
+  w.stats_.energy = after + still;
   if (!std::isfinite(before) || !std::isfinite(after)) return;  // the guard reports non-finite states
-  if (externalWork(w, ctx)) {
+  if (!watch) {
     w.energy_rise_ = 0;
     return;
   }
   w.energy_rise_ = std::max(Real(0), w.energy_rise_ + (after - before));
-  Real scale = 0;
-  for (const Spring& s : w.springs_)
-    if (s.alive) scale += springEnergyAt(w, s, nullptr);
-  const Real g = w.gravity_.norm();
-  for (const Body& b : w.bodies_) {
-    if (!b.alive || !b.isDynamic() || b.asleep) continue;
-    scale += b.kineticEnergy() + b.mass * g * std::sqrt(std::max(Real(0), b.inertia_body.trace() / (2 * b.mass)));
-  }
   if (!(w.energy_rise_ > w.settings_.energy_rise * scale) || scale <= 0) return;
   w.diagnose(-1, "energy rise",
              "energy rose by " + fmt(w.energy_rise_) + " J without external work (tolerance energy_rise = " +
@@ -235,9 +229,7 @@ Real watchPenetration(WorldImpl& w, StepContext& ctx) {
   ctx.supports.clear();
   // The depths first, each contact on its own (on the pool's threads when
   // there are many), then the reports in contact order.
-  const auto still = [&](const Contact& c) {
-    return stillThroughStep(w, ctx, c.body_a) && stillThroughStep(w, ctx, c.body_b);
-  };
+  const auto still = [&](const Contact& c) { return !movedInStep(ctx, c.body_a) && !movedInStep(ctx, c.body_b); };
   const auto depths = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       Contact& c = w.contacts_[static_cast<size_t>(i)];
@@ -333,6 +325,7 @@ Real thinnestShape(const WorldImpl& w) {
 void watchFastBodies(WorldImpl& w, StepContext& ctx) {
   Real thinnest = -1;  // found once per step, and only when a body is fast enough to need it
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    if (!ctx.moves(i)) continue;
     const Body& b = w.bodies_[i];
     if (!b.alive || !b.isDynamic() || b.asleep || b.ccd || b.shapes.empty()) continue;
     const Vec3 from = ctx.step_start[i].x, to = b.position;

@@ -202,24 +202,41 @@ void WorldImpl::diagnose(std::int32_t body, const char* kind, const std::string&
 
 void saveStepStart(WorldImpl& w, StepContext& ctx) {
   ctx.step_start.resize(w.bodies_.size());
+  ctx.start_energy.assign(w.bodies_.size(), Real(0));
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
     Body& b = w.bodies_[i];
     if (!b.alive) continue;
-    if (finiteState(b)) {
-      ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity, b.asleep};
+    if (!finiteState(b)) {
+      // Set through the API since the last step: back to the last good
+      // state. Its island has not moved yet, so this body alone is restored.
+      const char* what = badField(b);
+      restoreBody(w, ctx, i);
+      w.numerical_events_.push_back({w.step_count_, w.bodyId(static_cast<int>(i)), b.name, "step start", -1, 1,
+                                     std::string(what) + " set between steps"});
+      // The step starts from the last good state as saved, velocities and all.
+      if (b.isDynamic()) {
+        const StepContext::SavedState& st = ctx.step_start[i];
+        const Mat3 r = st.q.toRotationMatrix();
+        ctx.start_energy[i] = Real(0.5) * b.mass * st.v.squaredNorm() +
+                              Real(0.5) * st.w.dot(r * (b.inertia_body * (r.transpose() * st.w))) -
+                              b.mass * w.gravity_.dot(st.x);
+      }
       continue;
     }
-    // Set through the API since the last step: back to the last good state.
-    // Its island has not moved yet, so this body alone is restored.
-    const char* what = badField(b);
-    restoreBody(w, ctx, i);
-    w.numerical_events_.push_back({w.step_count_, w.bodyId(static_cast<int>(i)), b.name, "step start", -1, 1,
-                                   std::string(what) + " set between steps"});
+    ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity, b.asleep};
+    // At rest (every sleeping body) T is +0 to the bit, without reading the
+    // body's rotation and inertia.
+    if (b.isDynamic()) {
+      const bool rest = b.linear_velocity == Vec3::Zero() && b.angular_velocity == Vec3::Zero();
+      ctx.start_energy[i] = (rest ? Real(0) : b.kineticEnergy()) - b.mass * w.gravity_.dot(b.position);
+    }
   }
 }
 
+// Only a body that could move has a new state to save (StepContext::moves).
 void saveStepEnd(WorldImpl& w, StepContext& ctx) {
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    if (!ctx.moves(i)) continue;
     const Body& b = w.bodies_[i];
     if (b.alive) ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity, b.asleep};
   }
@@ -227,6 +244,7 @@ void saveStepEnd(WorldImpl& w, StepContext& ctx) {
 
 void guardBodies(WorldImpl& w, StepContext& ctx, const char* stage) {
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    if (!ctx.moves(i)) continue;  // unchanged since saveStepStart found it finite
     const Body& b = w.bodies_[i];
     if (!b.alive || b.asleep || b.type == BodyType::Static || finiteState(b)) continue;
     const std::int32_t isl = ctx.body_island[i];
@@ -238,9 +256,10 @@ void guardBodies(WorldImpl& w, StepContext& ctx, const char* stage) {
 
 void guardSolve(WorldImpl& w, StepContext& ctx) {
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
-    const Body& b = w.bodies_[i];
     const std::int32_t isl = ctx.body_island[i];
-    if (!b.alive || isl < 0 || ctx.frozen_island[static_cast<size_t>(isl)] || finiteState(b)) continue;
+    if (isl < 0) continue;
+    const Body& b = w.bodies_[i];
+    if (!b.alive || ctx.frozen_island[static_cast<size_t>(isl)] || finiteState(b)) continue;
     const std::string row = badConstraint(w, ctx, isl);
     if (!row.empty()) freezeIsland(w, ctx, isl, i, "row building", row);
     else freezeIsland(w, ctx, isl, i, "constraint solve", solveCulprit(w, ctx, isl));

@@ -49,10 +49,10 @@ void applyForces(WorldImpl& w, StepContext& ctx) {
 
 void integrateVelocities(WorldImpl& w, StepContext& ctx) {
   const Real h = ctx.hs;
-  ctx.orientation_offset.resize(w.bodies_.size());
+  ctx.orientation_offset.assign(w.bodies_.size(), Vec3::Zero());
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    if (!ctx.moves(i)) continue;
     Body& b = w.bodies_[i];
-    ctx.orientation_offset[i].setZero();
     if (!b.alive || b.asleep || !b.isDynamic() || frozen(ctx, i)) continue;
     bool gyro_ok = true;
     ctx.orientation_offset[i] = integrateVelocity(b, w.gravity_, h, w.settings_.gyroscopic, &gyro_ok);
@@ -74,6 +74,7 @@ void integratePositions(WorldImpl& w, StepContext& ctx) {
   const Real h = ctx.hs;
   const OrientationIntegrator method = w.settings_.orientation;
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
+    if (!ctx.moves(i)) continue;
     Body& b = w.bodies_[i];
     if (!b.alive || b.asleep || b.type == BodyType::Static || frozen(ctx, i)) continue;
     const std::int32_t si = ctx.solver_of_body[i];

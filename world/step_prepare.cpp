@@ -244,23 +244,18 @@ void orderSolverBodies(WorldImpl& w, StepContext& ctx) {
   for (size_t k = 1; k < ctx.island_first_body.size(); ++k) ctx.island_first_body[k] += ctx.island_first_body[k - 1];
   for (std::int32_t& first : ctx.island_first_body) ++first;  // index 0 is the world
   ctx.dynamic_count = ctx.island_first_body.back() - 1;
-  int kinematic = 0;
-  for (const Body& b : w.bodies_)
-    if (b.alive && b.type == BodyType::Kinematic) ++kinematic;
-  ctx.solver_count = 1 + ctx.dynamic_count + kinematic;
+  ctx.solver_count = 1 + ctx.dynamic_count + static_cast<int>(ctx.kinematic_bodies.size());
   ctx.solver_of_body.assign(n, ctx.static_index);
   ctx.body_of_solver.assign(static_cast<size_t>(ctx.solver_count), -1);
   ctx.island_fill.assign(ctx.island_first_body.begin(), ctx.island_first_body.end() - 1);
-  std::int32_t next_kinematic = 1 + ctx.dynamic_count;
-  for (size_t i = 0; i < n; ++i) {
-    const Body& b = w.bodies_[i];
-    std::int32_t si = -1;
-    if (ctx.body_island[i] >= 0) si = ctx.island_fill[static_cast<size_t>(ctx.body_island[i])]++;
-    else if (b.alive && b.type == BodyType::Kinematic) si = next_kinematic++;
-    if (si < 0) continue;
+  const auto place = [&](size_t i, std::int32_t si) {
     ctx.solver_of_body[i] = si;
     ctx.body_of_solver[static_cast<size_t>(si)] = static_cast<std::int32_t>(i);
-  }
+  };
+  for (size_t i = 0; i < n; ++i)
+    if (ctx.body_island[i] >= 0) place(i, ctx.island_fill[static_cast<size_t>(ctx.body_island[i])]++);
+  std::int32_t next_kinematic = 1 + ctx.dynamic_count;
+  for (const std::int32_t i : ctx.kinematic_bodies) place(static_cast<size_t>(i), next_kinematic++);
   ctx.velocities.resize(static_cast<size_t>(ctx.solver_count));
   ctx.pseudo.resize(ctx.velocities.size());
 }

@@ -583,16 +583,19 @@ void WorldImpl::check(ShapeId id) const {
 void WorldImpl::applyForce(BodyId id, const Vec3& force, const Vec3& world_point) {
   wakeBody(id);
   external_forces_ = true;  // work from outside: the energy watcher holds off
+  forced_bodies_.push_back(id.index);
   applyForceAtPoint(body(id), force, world_point);
 }
 void WorldImpl::applyCentralForce(BodyId id, const Vec3& force) {
   wakeBody(id);
   external_forces_ = true;  // work from outside: the energy watcher holds off
+  forced_bodies_.push_back(id.index);
   body(id).force += force;
 }
 void WorldImpl::applyTorque(BodyId id, const Vec3& torque) {
   wakeBody(id);
   external_forces_ = true;  // work from outside: the energy watcher holds off
+  forced_bodies_.push_back(id.index);
   body(id).torque += torque;
 }
 void WorldImpl::applyImpulse(BodyId id, const Vec3& impulse, const Vec3& world_point) {

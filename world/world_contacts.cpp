@@ -119,15 +119,29 @@ void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
   b.shape_ids[static_cast<size_t>(index_in_body)] = slot;
 }
 
+void WorldImpl::refitProxy(const ShapeRef& ref, Real h) {
+  const Body& b = body(ref.body);
+  const ShapeDesc& shape = b.shapes[static_cast<size_t>(ref.index)];
+  Aabb box = shapeAabb(shape, b.transform() * shape.local);
+  if (!box.isInfinite()) box = box.expanded(reach(b, settings_.contact_margin, h));  // as registerShape does
+  broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
+}
+
 void WorldImpl::moveProxies(BodyId only, Real h) {
   for (const ShapeRef& ref : shapes_) {
     if (!ref.alive || (!only.isWorld() && ref.body.index != only.index)) continue;
     const Body& b = body(ref.body);
     if (only.isWorld() && (b.type == BodyType::Static || b.asleep)) continue;
-    const ShapeDesc& shape = b.shapes[static_cast<size_t>(ref.index)];
-    Aabb box = shapeAabb(shape, b.transform() * shape.local);
-    if (!box.isInfinite()) box = box.expanded(reach(b, settings_.contact_margin, h));  // as registerShape does
-    broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
+    refitProxy(ref, h);
+  }
+}
+
+void WorldImpl::moveAwakeProxies(Real h) {
+  for (const ShapeRef& ref : shapes_) {
+    if (!ref.alive || !ctx_.moves(static_cast<size_t>(ref.body.index))) continue;  // static or asleep: still there
+    const Body& b = body(ref.body);
+    if (b.type == BodyType::Static || b.asleep) continue;
+    refitProxy(ref, h);
   }
 }
 

@@ -99,6 +99,15 @@ struct StepContext {
   int dynamic_count = 0;
   int solver_count = 1;  // solver bodies in all
   static constexpr int static_index = 0;
+  // Whether a body slot can move in this step: awake dynamic or kinematic,
+  // the bodies with a solver index of their own. The others (static,
+  // asleep through the step, destroyed) keep the state saveStepStart saved,
+  // so the stages after the islands skip them on this compact array instead
+  // of reading each Body (a sleeping pile's step was mostly such walks).
+  bool moves(size_t body) const { return solver_of_body[body] != static_index; }
+  std::vector<std::int32_t> kinematic_bodies;  // alive kinematic body slots, in order (world/islands.cpp)
+  std::vector<std::uint8_t> body_flags;        // per body slot: the islands stage's view of it (world/islands.cpp)
+  int asleep_bodies = 0;                       // alive bodies asleep after the islands stage
   std::vector<SolverBody> velocities;  // v, w per solver body
   std::vector<SolverBody> pseudo;      // split-impulse pseudo-velocities
   bool has_pseudo = false;
@@ -145,6 +154,11 @@ struct StepContext {
     bool asleep = false;  // asleep when the step began (the watchers skip what cannot have moved)
   };
   std::vector<SavedState> step_start;  // per body slot: the last good state
+  // Per body slot: T + V when the step began (0 for a body that is not
+  // dynamic or not alive), as Body::kineticEnergy and -m g.x give it. A
+  // body that does not move keeps it to the bit, so the watchers sum it
+  // from here instead of reading the body again.
+  std::vector<Real> start_energy;
   std::vector<char> frozen_island;
   bool any_frozen = false;
 
@@ -278,6 +292,8 @@ class WorldImpl {
   // awake body that can move) so their fat boxes hold the shapes where they
   // are now, stretched along v h (world/world_contacts.cpp).
   void moveProxies(BodyId only, Real h);
+  void moveAwakeProxies(Real h);  // the step's end: only the bodies that moved (StepContext::moves)
+  void refitProxy(const ShapeRef& ref, Real h);  // the shape's fat box where its body now is
 
   // ----------------------------------------------------------------------
   // The state itself. The step's stages (world/*.cpp) work on these.
@@ -330,6 +346,7 @@ class WorldImpl {
   // The step's watchers (world/step_diagnostics.cpp).
   Real energy_rise_ = 0;          // energy gained since the low point of the current stretch without external work
   bool external_forces_ = false;  // a force or torque applied through the API for the coming step
+  std::vector<std::int32_t> forced_bodies_;  // body slots given a force or torque outside the step (cleared after it)
   void registerShape(BodyId id, std::int32_t index_in_body);
   void recomputeMass(Body& b, const std::string& object);
   void dropContactsOf(BodyId body, std::int32_t shape);  // shape -1: every shape of the body

@@ -54,6 +54,24 @@ class StageClock {
   std::chrono::steady_clock::time_point last_;
 };
 
+// The accumulators are spent: zero those that can hold anything, the
+// bodies that moved (constant forces wake theirs), the springs' ends and
+// what the API pushed, without reading every body.
+void clearForces(WorldImpl& w, const StepContext& ctx) {
+  const auto clear = [&](size_t i) {
+    w.bodies_[i].force.setZero();
+    w.bodies_[i].torque.setZero();
+  };
+  for (size_t i = 0; i < w.bodies_.size(); ++i)
+    if (ctx.moves(i)) clear(i);
+  for (const Spring& s : w.springs_)
+    for (const BodyId id : {s.def.body_a, s.def.body_b})
+      if (s.alive && !id.isWorld()) clear(static_cast<size_t>(id.index));
+  for (const std::int32_t i : w.forced_bodies_)
+    if (static_cast<size_t>(i) < w.bodies_.size()) clear(static_cast<size_t>(i));
+  w.forced_bodies_.clear();
+}
+
 // The worker pool follows SolverSettings::threads.
 void fitPool(WorldImpl& w) {
   const int threads = w.settings_.threads;
@@ -126,12 +144,9 @@ void WorldImpl::step(Real h) {
   clock.lap(Stage::Sleep);
   watchStep(*this, ctx);  // diagnostics: what went wrong without a NaN
   clock.lap(Stage::Guards);
-  moveProxies(kWorldBody, h);  // fat boxes hold the shapes where they ended, for queries between steps
-  clock.lap(Stage::Collide);   // the broadphase's work, wherever in the step it happens
-  for (Body& b : bodies_) {
-    b.force.setZero();
-    b.torque.setZero();
-  }
+  moveAwakeProxies(h);        // fat boxes hold the shapes where they ended, for queries between steps
+  clock.lap(Stage::Collide);  // the broadphase's work, wherever in the step it happens
+  clearForces(*this, ctx);
   saveStepEnd(*this, ctx);
   for (const Contact& c : contacts_) {
     if (!c.enabled) continue;

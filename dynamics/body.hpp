@@ -22,6 +22,14 @@
 
 namespace cairn {
 
+// Whether a body-frame inertia (or its inverse) is c 1, equal principal
+// moments about any axes: a cube, a sphere. Such a body feels no
+// gyroscopic torque, and R (c 1) R^T = c 1 for every rotation R.
+inline bool isIsotropic(const Mat3& j) {
+  return j(0, 1) == 0 && j(0, 2) == 0 && j(1, 0) == 0 && j(1, 2) == 0 && j(2, 0) == 0 && j(2, 1) == 0 &&
+         j(0, 0) == j(1, 1) && j(1, 1) == j(2, 2);
+}
+
 struct Body {
   std::string name;
   BodyType type = BodyType::Dynamic;
@@ -111,7 +119,9 @@ struct Body {
   // for any s > 0; s = tr(I) / 3 keeps both blocks of the same size.
   void updateDerived() {
     rotation = orientation.toRotationMatrix();
-    inv_inertia_world = rotation * inv_inertia_body * rotation.transpose();
+    // c 1 turns into itself: exactly, where the product would add round-off.
+    if (isIsotropic(inv_inertia_body)) inv_inertia_world = inv_inertia_body;
+    else inv_inertia_world = rotation * inv_inertia_body * rotation.transpose();
     if (rotation_locked && isDynamic()) {
       const Mat3 inertia_world = rotation * inertia_body * rotation.transpose();
       const Mat3& p = rotation_projector;

@@ -36,9 +36,13 @@ namespace {
 
 using Item = GraphItem;
 
+std::int32_t solverIndex(const StepContext& ctx, BodyId id) {
+  return id.isWorld() ? ctx.static_index : ctx.solver_of_body[static_cast<size_t>(id.index)];
+}
+
 BodyView solverView(const WorldImpl& w, const StepContext& ctx, BodyId id) {
   BodyView v = w.view(id);
-  v.solver_index = id.isWorld() ? ctx.static_index : ctx.solver_of_body[static_cast<size_t>(id.index)];
+  v.solver_index = solverIndex(ctx, id);
   return v;
 }
 
@@ -306,16 +310,16 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
     const std::int32_t isl = ctx.joint_island[i];
     if (!live(isl) || !pgs(isl)) continue;
     const Joint& j = w.joints_[i];
-    items.push_back({Item::JointGroup, static_cast<std::int32_t>(i), solverView(w, ctx, j.def.body_a).solver_index,
-                     solverView(w, ctx, j.def.body_b).solver_index, isl});
+    items.push_back({Item::JointGroup, static_cast<std::int32_t>(i), solverIndex(ctx, j.def.body_a),
+                     solverIndex(ctx, j.def.body_b), isl});
   }
   for (size_t i = 0; i < w.contacts_.size(); ++i) {
     const std::int32_t isl = ctx.contact_island[i];
     if (!live(isl) || !pgs(isl)) continue;
     const Contact& c = w.contacts_[i];
     const Item::Kind kind = usesRowGroup(c) ? Item::ContactGroup : Item::Manifold;
-    items.push_back({kind, static_cast<std::int32_t>(i), solverView(w, ctx, c.body_a).solver_index,
-                     solverView(w, ctx, c.body_b).solver_index, isl});
+    items.push_back({kind, static_cast<std::int32_t>(i), solverIndex(ctx, c.body_a),
+                     solverIndex(ctx, c.body_b), isl});
   }
   const std::int32_t dyn = ctx.dynamic_count + 1;  // the solver indices below this, but 0, are dynamic
   const auto isDyn = [&](std::int32_t si) { return si > 0 && si < dyn; };

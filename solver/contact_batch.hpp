@@ -83,6 +83,45 @@ struct alignas(64) ContactBatch {
   Lanes sweep_delta, sweep_lambda, change2;
 };
 
+// What the fill kernel reads to make a batch's eight lanes (the step
+// gathers it, lane by lane, from the manifolds and their bodies: world/
+// step_prepare.cpp). Per body: the center of mass, the orientation as a
+// quaternion (x, y, z, w), the inverse mass and the translation locks'
+// factors, the full world inverse inertia (row-major: the product may leave
+// it unsymmetric by round-off, and the rows are made with all nine
+// entries), and the velocities; per manifold its normal and materials; per
+// point the anchors in the bodies' frames and what it carries from the
+// last step. A point past the manifold's count is all zeros.
+struct alignas(64) ContactBatchInput {
+  using Lanes = double[kBatchLanes];
+  struct Side {
+    Lanes x[3], q[4];
+    Lanes inv_mass, lin_factor[3];
+    Lanes inv_inertia[9];
+    Lanes v[3], w[3];
+  } a, b;
+  Lanes n[3];
+  Lanes friction, restitution;
+  struct Point {
+    Lanes local_a[3], local_b[3];
+    Lanes approach_speed, max_impulse, normal_impulse, friction_impulse[3];
+  } p[kMaxPoints];
+};
+
+// The step's constants for the fill.
+struct ContactFillParams {
+  double h = 0;               // the substep
+  double cfm = 0;             // impulse-form CFM (ODE's CFM / h)
+  double contact_erp = 0;     // push-out rate: contact_erp / h of the depth past the slop
+  double slop = 0;            // depth left uncorrected
+  double threshold = 0;       // restitution threshold (m/s)
+  double max_correction = 0;  // cap of the push-out speed
+  double warm = 0;            // warm-start factor (0: cold)
+  bool in_rhs = false;        // the push-out in the velocity target (Baumgarte), not the correction pass
+  bool first_substep = true;  // restitution's largest impulse starts over
+  int friction_rows = 2;      // tangent rows per point
+};
+
 // What a kernel sweep needs besides the batches.
 struct ContactSweepParams {
   double sor = 1;

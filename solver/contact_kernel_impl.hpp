@@ -86,6 +86,28 @@ struct Kernel {
   CAIRN_INLINE D vmin(D a, D b) { return a < b ? a : b; }
   CAIRN_INLINE D vabs(D a) { return a < 0 ? -a : a; }
   CAIRN_INLINE D sel(M m, D a, D b) { return m ? a : b; }
+  CAIRN_INLINE D vsqrt(D a) {
+#if defined(__AVX512F__)
+    if constexpr (W == 8) {
+      __m512d r;
+      __builtin_memcpy(&r, &a, 64);
+      r = _mm512_maskz_sqrt_pd(0xFF, r);  // all eight lanes (the unmasked form trips GCC 12's -Wuninitialized)
+      __builtin_memcpy(&a, &r, 64);
+      return a;
+    }
+#endif
+#if defined(__AVX__)
+    if constexpr (W == 4) {
+      __m256d r;
+      __builtin_memcpy(&r, &a, 32);
+      r = _mm256_sqrt_pd(r);
+      __builtin_memcpy(&a, &r, 32);
+      return a;
+    }
+#endif
+    for (int i = 0; i < W; ++i) a[i] = __builtin_sqrt(a[i]);  // IEEE: correctly rounded, as the vector forms
+    return a;
+  }
   CAIRN_INLINE M allTrue() {
     const D one = splat(1);
     return one > 0;
@@ -647,6 +669,178 @@ struct Kernel {
       }
     }
   }
+
+  // --- The fill: a batch's eight manifolds into its lanes, W at a time,
+  // from the gathered ContactBatchInput. The arithmetic of each lane is
+  // the scalar fill's, operation for operation (Eigen's order for the
+  // quaternion rotation, dots, products and normalisation), so the lanes
+  // hold the same bits as when each manifold was filled alone.
+
+  // Eigen's q * v: uv = 2 (q_vec x v); v + w uv + q_vec x uv.
+  CAIRN_INLINE V3 rotate(const ContactBatchInput::Side& s, int o, const V3& v) {
+    const V3 qv{ld(s.q[0] + o), ld(s.q[1] + o), ld(s.q[2] + o)};
+    const D qw = ld(s.q[3] + o);
+    V3 uv = cross(qv, v);
+    uv = add(uv, uv);
+    return add(add(v, mul(uv, qw)), cross(qv, uv));
+  }
+  // Row-major 3x3 times a vector, summed as Eigen sums a fixed 3x3 times
+  // 3-vector product with SSE2: the first two rows left to right (one
+  // packet), the third as its redux tail, a0 + (a1 + a2).
+  struct M3 {
+    D m[9];
+  };
+  CAIRN_INLINE M3 ldm(const double (*p)[kBatchLanes], int o) {
+    M3 r;
+    for (int k = 0; k < 9; ++k) r.m[k] = ld(p[k] + o);
+    return r;
+  }
+  CAIRN_INLINE V3 mulM(const M3& a, const V3& v) {
+    return {a.m[0] * v.x + a.m[1] * v.y + a.m[2] * v.z, a.m[3] * v.x + a.m[4] * v.y + a.m[5] * v.z,
+            a.m[6] * v.x + (a.m[7] * v.y + a.m[8] * v.z)};
+  }
+  CAIRN_INLINE void st3(double (*p)[kBatchLanes], int o, const V3& v) {
+    st(p[0] + o, v.x);
+    st(p[1] + o, v.y);
+    st(p[2] + o, v.z);
+  }
+  // The kernels' symmetric form: xx, yy, zz, xy, xz, yz of the upper triangle.
+  CAIRN_INLINE void stUpper(double (*dst)[kBatchLanes], int o, const M3& m) {
+    st(dst[0] + o, m.m[0]);
+    st(dst[1] + o, m.m[4]);
+    st(dst[2] + o, m.m[8]);
+    st(dst[3] + o, m.m[1]);
+    st(dst[4] + o, m.m[2]);
+    st(dst[5] + o, m.m[5]);
+  }
+  CAIRN_INLINE V3 sel3(M m, const V3& a, const V3& b) { return {sel(m, a.x, b.x), sel(m, a.y, b.y), sel(m, a.z, b.z)}; }
+
+  static void fill(ContactBatch& b, const ContactBatchInput& in, const ContactFillParams& p) {
+    const D zero_ = zero(), one = splat(1), cfm = splat(p.cfm), h = splat(p.h);
+    for (int o = 0; o < kBatchLanes; o += W) {
+      D count;
+      for (int i = 0; i < W; ++i) count[i] = b.count[o + i];
+      // Mass data: m^-1 per axis (the locks' factors), the symmetric
+      // inverse inertia the sweeps read (upper triangle of the full one).
+      const V3 ma = mul(ld3(in.a.lin_factor, o), ld(in.a.inv_mass + o));
+      const V3 mb = mul(ld3(in.b.lin_factor, o), ld(in.b.inv_mass + o));
+      st3(b.ma, o, ma);
+      st3(b.mb, o, mb);
+      const M3 ia = ldm(in.a.inv_inertia, o), ib = ldm(in.b.inv_inertia, o);
+      stUpper(b.ia, o, ia);
+      stUpper(b.ib, o, ib);
+      const V3 n = ld3(in.n, o);
+      st3(b.n, o, n);
+      const D mu = ld(in.friction + o);
+      st(b.mu + o, mu);
+      st(b.cfm + o, sel(count > 0, cfm, zero_));  // a padding lane has no rows, and no CFM
+      st(b.sweep_delta + o, zero_);
+      st(b.sweep_lambda + o, zero_);
+      st(b.change2 + o, zero_);
+      const V3 m_ab = add(ma, mb);
+      const V3 xa = ld3(in.a.x, o), xb = ld3(in.b.x, o);
+      const V3 va = ld3(in.a.v, o), wa = ld3(in.a.w, o), vb = ld3(in.b.v, o), wb = ld3(in.b.w, o);
+      const D lin_n = dot(n, cmul(m_ab, n));
+
+      V3 ran[kMaxPoints], rbn[kMaxPoints], ia_ran[kMaxPoints], ib_rbn[kMaxPoints];
+      M valid[kMaxPoints];
+      for (int i = 0; i < kMaxPoints; ++i) {
+        ContactBatch::Point& q = b.p[i];
+        const ContactBatchInput::Point& ip = in.p[i];
+        const M real = count > static_cast<double>(i);
+        const V3 pa = add(xa, rotate(in.a, o, ld3(ip.local_a, o)));
+        const V3 pb = add(xb, rotate(in.b, o, ld3(ip.local_b, o)));
+        const V3 ra = sub(pa, xa), rb = sub(pb, xb);
+        ran[i] = sel3(real, cross(ra, n), zero3());
+        rbn[i] = sel3(real, cross(rb, n), zero3());
+        ia_ran[i] = sel3(real, mulM(ia, ran[i]), zero3());
+        ib_rbn[i] = sel3(real, mulM(ib, rbn[i]), zero3());
+        const D k = lin_n + dot(ran[i], ia_ran[i]) + dot(rbn[i], ib_rbn[i]);
+        const M ok = real & (k > 0);  // neither body can move along the normal here (locks): no row
+        valid[i] = ok;
+        const auto put = [&](double* dst, D v) { st(dst + o, sel(ok, v, zero_)); };
+        const auto put3 = [&](double (*dst)[kBatchLanes], const V3& v) {
+          put(dst[0], v.x);
+          put(dst[1], v.y);
+          put(dst[2], v.z);
+        };
+        put(q.valid, one);
+        put3(q.ran, ran[i]);
+        put3(q.rbn, rbn[i]);
+        put(q.normal_mass, k + cfm);  // inverted with the batch
+        st(q.lambda_bias + o, zero_);
+        st(q.change_n + o, zero_);
+        st(q.dir_n + o, zero_);
+        for (int k2 = 0; k2 < 2; ++k2) {
+          st(q.change_t[k2] + o, zero_);
+          st(q.dir_t[k2] + o, zero_);
+        }
+
+        // Targets: close a gap within the step and no more (speculative);
+        // push the penetration beyond the slop out at contact_erp / h.
+        const D sep = dot(sub(pb, pa), n);
+        const D want = splat(p.contact_erp) / h * (-sep - splat(p.slop));
+        const D clamped = sel(want < 0, zero_, sel(splat(p.max_correction) < want, splat(p.max_correction), want));
+        const D push = sel(sep > 0, zero_, clamped);
+        D rhs = sel(sep > 0, -sep / h, zero_);
+        if (p.in_rhs) {
+          rhs = sel(rhs < push, push, rhs);  // std::max's choice, NaN included
+          st(q.bias + o, zero_);
+        } else {
+          put(q.bias, sel(sep > 0, -sep / h, push));  // > 0: being pushed out
+        }
+        put(q.rhs, rhs);
+        const D approach = ld(ip.approach_speed + o), e = ld(in.restitution + o);
+        const M bounces = (e > 0) & (-approach > splat(p.threshold));
+        put(q.bounce, sel(bounces, -e * approach, zero_));
+        put(q.max_lambda, p.first_substep ? zero_ : ld(ip.max_impulse + o));
+        put(q.lambda, splat(p.warm) * ld(ip.normal_impulse + o));
+
+        // Friction: the first tangent along the sliding direction when
+        // sliding, else along the carried friction impulse, else any
+        // perpendicular (Eigen's anyPerpendicular: n x (x or y), normalised).
+        const V3 vrel = sub(add(vb, cross(wb, rb)), add(va, cross(wa, ra)));
+        const V3 vt = sub(vrel, mul(n, dot(n, vrel)));
+        const V3 fi = ld3(ip.friction_impulse, o);
+        const V3 carried = sub(fi, mul(n, dot(n, fi)));
+        const D vt2 = dot(vt, vt), carried2 = dot(carried, carried);
+        const M use_x = vabs(n.x) < 0.57735;
+        const V3 axis{sel(use_x, one, zero_), sel(use_x, zero_, one), zero_};
+        const V3 perp = cross(n, axis);
+        const D perp2 = dot(perp, perp);
+        const D rp = vsqrt(sel(perp2 > 0, perp2, one));
+        V3 t1 = sel3(perp2 > 0, V3{perp.x / rp, perp.y / rp, perp.z / rp}, perp);
+        const M carried_ok = carried2 > 1e-24;
+        const D rc = vsqrt(sel(carried_ok, carried2, one));
+        t1 = sel3(carried_ok, V3{carried.x / rc, carried.y / rc, carried.z / rc}, t1);
+        const M sliding = vt2 > 1e-6;
+        const D rv = vsqrt(sel(sliding, vt2, one));
+        t1 = sel3(sliding, V3{vt.x / rv, vt.y / rv, vt.z / rv}, t1);
+        put3(q.t, t1);
+        const M rubs = ok & (mu > 0);
+        for (int k2 = 0; k2 < 2; ++k2) {
+          const bool row = k2 < p.friction_rows;
+          const V3 t = k2 == 0 ? t1 : cross(n, t1);
+          const V3 rat = cross(ra, t), rbt = cross(rb, t);
+          const D kt = dot(t, cmul(m_ab, t)) + dot(rat, mulM(ia, rat)) + dot(rbt, mulM(ib, rbt));
+          const M on = row ? rubs : M{};
+          for (int c = 0; c < 3; ++c) {
+            st(q.rat[k2][c] + o, sel(on, c == 0 ? rat.x : c == 1 ? rat.y : rat.z, zero_));
+            st(q.rbt[k2][c] + o, sel(on, c == 0 ? rbt.x : c == 1 ? rbt.y : rbt.z, zero_));
+          }
+          st(q.tangent_mass[k2] + o, sel(on, kt + cfm, zero_));  // inverted with the batch (<= 0: no row)
+          st(q.lambda_t[k2] + o, sel(on, splat(p.warm) * dot(fi, t), zero_));
+        }
+      }
+      // The normal block, padded to 4 x 4 with identity rows.
+      for (int i = 0; i < kMaxPoints; ++i)
+        for (int j = 0; j <= i; ++j) {
+          D v = lin_n + dot(ran[i], ia_ran[j]) + dot(rbn[i], ib_rbn[j]) + (i == j ? cfm : zero_);
+          v = sel(valid[i] & valid[j], v, i == j ? one : zero_);
+          st(b.block[tri(i, j)] + o, v);
+        }
+    }
+  }
 };
 
 #undef CAIRN_INLINE
@@ -656,7 +850,8 @@ struct Kernel {
 // The table of this unit's kernels.
 inline ContactKernels makeKernels(const char* name) {
   using K = Kernel<CAIRN_KERNEL_LANES>;
-  return ContactKernels{name, CAIRN_KERNEL_LANES, &K::warmStart, &K::solveNormals, &K::solveFriction, &K::momentum, &K::solveBias, &K::restitution};
+  return ContactKernels{name,          CAIRN_KERNEL_LANES, &K::warmStart, &K::solveNormals, &K::solveFriction,
+                        &K::momentum,  &K::solveBias,      &K::restitution, &K::fill};
 }
 
 }  // namespace CAIRN_KERNEL_NS

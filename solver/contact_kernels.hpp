@@ -46,6 +46,10 @@ struct ContactKernels {
   // are driven to their bounce velocity (the others to no approach), by
   // projected sweeps on the normal block.
   void (*restitution)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
+  // Fills a batch's lanes from what the step gathered for them (body_a,
+  // body_b, island and count are already set; the Cholesky factor and the
+  // inverted effective masses are the step's, after this).
+  void (*fill)(ContactBatch& batch, const ContactBatchInput& in, const ContactFillParams& p);
 };
 
 enum class SimdLevel { Portable, Avx2, Avx512 };

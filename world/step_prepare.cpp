@@ -53,20 +53,6 @@ std::int32_t islandOf(const StepContext& ctx, BodyId a, BodyId b) {
 
 bool usesRowGroup(const Contact& c) { return c.rolling_friction > 0 || c.torsional_friction > 0; }
 
-// The symmetric matrix as the kernels store it: xx, yy, zz, xy, xz, yz.
-void storeSym(double (*dst)[kBatchLanes], int lane, const Mat3& m) {
-  dst[0][lane] = m(0, 0);
-  dst[1][lane] = m(1, 1);
-  dst[2][lane] = m(2, 2);
-  dst[3][lane] = m(0, 1);
-  dst[4][lane] = m(0, 2);
-  dst[5][lane] = m(1, 2);
-}
-
-void store3(double (*dst)[kBatchLanes], int lane, const Vec3& v) {
-  for (int k = 0; k < 3; ++k) dst[k][lane] = v[k];
-}
-
 int tri(int i, int j) { return i * (i + 1) / 2 + j; }
 
 // Cholesky factors of the blocks A_b + eps I of a batch's eight lanes,
@@ -110,131 +96,42 @@ void invertRowMasses(ContactBatch& b) {
 // handover (solver/graph_solver.cpp measures the same trade for the solve).
 constexpr int kParallelBatches = 16;
 
-struct ContactParams {
-  Real h = 0, cfm = 0, contact_erp = 0, slop = 0, threshold = 0, max_correction = 0, warm = 0;
-  Correction correction = Correction::PseudoVelocity;
-  bool first_substep = true;
-  int friction_rows = 2;
-};
-
-// One manifold into one lane (contact_batch.hpp lists the fields).
-void fillLane(ContactBatch& batch, int lane, const Contact& c, const BodyView& a, const BodyView& b,
-              std::int32_t island, const ContactParams& cp) {
+// One manifold and its bodies into one lane of the fill kernel's input
+// (solver/contact_batch.hpp lists the fields; the kernel makes the lane).
+void gatherLane(ContactBatchInput& in, ContactBatch& batch, int lane, const Contact& c, const BodyView& a,
+                const BodyView& b, std::int32_t island) {
   batch.body_a[lane] = a.solver_index;
   batch.body_b[lane] = b.solver_index;
   batch.island[lane] = island;
   batch.count[lane] = c.count;
-  const Vec3 ma = a.inv_mass * a.lin_factor, mb = b.inv_mass * b.lin_factor;
-  store3(batch.ma, lane, ma);
-  store3(batch.mb, lane, mb);
-  storeSym(batch.ia, lane, a.inv_inertia);
-  storeSym(batch.ib, lane, b.inv_inertia);
-  const Vec3& n = c.normal;
-  store3(batch.n, lane, n);
-  batch.mu[lane] = c.friction;
-  batch.cfm[lane] = cp.cfm;
-  batch.sweep_delta[lane] = batch.sweep_lambda[lane] = batch.change2[lane] = 0;
-  // The linear part of J M^-1 J^T along a direction u: u . (m_a^-1 + m_b^-1) u.
-  const Vec3 m_ab = ma + mb;
-  const auto linear = [&](const Vec3& u) { return u.dot(m_ab.cwiseProduct(u)); };
-
-  Vec3 ran[kMaxPoints], rbn[kMaxPoints], ia_ran[kMaxPoints], ib_rbn[kMaxPoints];  // and I^-1 (r x n)
-  bool valid[kMaxPoints] = {};
+  const auto side = [lane](ContactBatchInput::Side& s, const BodyView& v) {
+    for (int k = 0; k < 3; ++k) {
+      s.x[k][lane] = v.x[k];
+      s.lin_factor[k][lane] = v.lin_factor[k];
+      s.v[k][lane] = v.v[k];
+      s.w[k][lane] = v.w[k];
+      for (int j = 0; j < 3; ++j) s.inv_inertia[3 * k + j][lane] = v.inv_inertia(k, j);
+    }
+    for (int k = 0; k < 4; ++k) s.q[k][lane] = v.q.coeffs()[k];  // x, y, z, w
+    s.inv_mass[lane] = v.inv_mass;
+  };
+  side(in.a, a);
+  side(in.b, b);
+  for (int k = 0; k < 3; ++k) in.n[k][lane] = c.normal[k];
+  in.friction[lane] = c.friction;
+  in.restitution[lane] = c.restitution;
   for (int i = 0; i < kMaxPoints; ++i) {
-    ContactBatch::Point& q = batch.p[i];
-    ran[i] = rbn[i] = ia_ran[i] = ib_rbn[i] = Vec3::Zero();
-    q.valid[lane] = 0;
-    q.lambda[lane] = q.lambda_t[0][lane] = q.lambda_t[1][lane] = 0;
-    q.max_lambda[lane] = q.lambda_bias[lane] = 0;
-    q.rhs[lane] = q.bias[lane] = q.bounce[lane] = 0;
-    q.normal_mass[lane] = q.tangent_mass[0][lane] = q.tangent_mass[1][lane] = 0;
-    q.change_n[lane] = q.change_t[0][lane] = q.change_t[1][lane] = 0;
-    q.dir_n[lane] = q.dir_t[0][lane] = q.dir_t[1][lane] = 0;
-    for (int k = 0; k < 3; ++k)
-      q.ran[k][lane] = q.rbn[k][lane] = q.t[k][lane] = q.rat[0][k][lane] = q.rat[1][k][lane] = q.rbt[0][k][lane] =
-          q.rbt[1][k][lane] = 0;
-    if (i >= c.count) continue;
-    const ContactPointState& s = c.points[i];
-    const Vec3 pa = worldPoint(a, s.local_a), pb = worldPoint(b, s.local_b);
-    const Vec3 ra = pa - a.x, rb = pb - b.x;
-    ran[i] = ra.cross(n);
-    rbn[i] = rb.cross(n);
-    ia_ran[i] = a.inv_inertia * ran[i];
-    ib_rbn[i] = b.inv_inertia * rbn[i];
-    const Real k = linear(n) + ran[i].dot(ia_ran[i]) + rbn[i].dot(ib_rbn[i]);
-    if (!(k > 0)) continue;  // neither body can move along the normal here (locks)
-    valid[i] = true;
-    q.valid[lane] = 1;
-    store3(q.ran, lane, ran[i]);
-    store3(q.rbn, lane, rbn[i]);
-    q.normal_mass[lane] = k + cp.cfm;  // inverted by invertRowMasses
-
-    // Targets: close a gap within the step and no more (speculative); push
-    // the penetration beyond the slop out at contact_erp / h.
-    const Real sep = (pb - pa).dot(n);
-    const Real push = sep > 0 ? 0 : std::clamp(cp.contact_erp / cp.h * (-sep - cp.slop), Real(0), cp.max_correction);
-    Real rhs = sep > 0 ? -sep / cp.h : Real(0);
-    if (cp.correction == Correction::InRhs) {
-      rhs = std::max(rhs, push);
-    } else {
-      // Every point of the manifold takes part in the correction pass
-      // (target 0 within the slop, -gap/h while separated), so pushing one
-      // corner out lifts the body instead of tipping it.
-      q.bias[lane] = sep > 0 ? -sep / cp.h : push;  // > 0: being pushed out
+    ContactBatchInput::Point& q = in.p[i];
+    const ContactPointState s = i < c.count ? c.points[i] : ContactPointState{};
+    for (int k = 0; k < 3; ++k) {
+      q.local_a[k][lane] = s.local_a[k];
+      q.local_b[k][lane] = s.local_b[k];
+      q.friction_impulse[k][lane] = s.friction_impulse[k];
     }
-    q.rhs[lane] = rhs;
-    // Restitution: the approach speed at detection, before this step's
-    // forces, applied once after the solve (applyRestitution).
-    if (c.restitution > 0 && -s.approach_speed > cp.threshold) q.bounce[lane] = -c.restitution * s.approach_speed;
-    q.max_lambda[lane] = cp.first_substep ? Real(0) : s.max_impulse;
-    q.lambda[lane] = cp.warm * s.normal_impulse;
-
-    // Friction: the first tangent along the sliding direction when sliding,
-    // so the pyramid's corners do not favour axes; otherwise along the
-    // carried friction impulse, else any perpendicular.
-    const Vec3 vrel = (b.v + b.w.cross(rb)) - (a.v + a.w.cross(ra));
-    const Vec3 vt = vrel - n * n.dot(vrel);
-    const Vec3 carried = s.friction_impulse - n * n.dot(s.friction_impulse);
-    Vec3 t1;
-    const Real vt2 = vt.squaredNorm(), carried2 = carried.squaredNorm();  // one square root, not two
-    if (vt2 > Real(1e-6)) t1 = vt / std::sqrt(vt2);
-    else if (carried2 > Real(1e-24)) t1 = carried / std::sqrt(carried2);
-    else t1 = anyPerpendicular(n);
-    store3(q.t, lane, t1);
-    if (c.friction > 0) {
-      // A tangent row left out keeps a zero effective mass: no row (the
-      // residual, the statistics and the exported rows skip it).
-      for (int k2 = 0; k2 < cp.friction_rows; ++k2) {
-        const Vec3 t = k2 == 0 ? t1 : Vec3(n.cross(t1));
-        const Vec3 rat = ra.cross(t), rbt = rb.cross(t);
-        store3(q.rat[k2], lane, rat);
-        store3(q.rbt[k2], lane, rbt);
-        const Real kt = linear(t) + rat.dot(a.inv_inertia * rat) + rbt.dot(b.inv_inertia * rbt);
-        q.tangent_mass[k2][lane] = kt + cp.cfm;  // inverted by invertRowMasses (<= 0: no row)
-        q.lambda_t[k2][lane] = cp.warm * s.friction_impulse.dot(t);
-      }
-    }
+    q.approach_speed[lane] = s.approach_speed;
+    q.max_impulse[lane] = s.max_impulse;
+    q.normal_impulse[lane] = s.normal_impulse;
   }
-
-  // The normal block, padded to 4 x 4 with identity rows.
-  const Real lin_n = linear(n);
-  for (int i = 0; i < kMaxPoints; ++i)
-    for (int j = 0; j <= i; ++j) {
-      Real v;
-      if (valid[i] && valid[j])
-        v = lin_n + ran[i].dot(ia_ran[j]) + rbn[i].dot(ib_rbn[j]) + (i == j ? cp.cfm : Real(0));
-      else
-        v = i == j ? Real(1) : Real(0);
-      batch.block[tri(i, j)][lane] = v;
-    }
-  // factorBatch and invertRowMasses finish the lane with its batch.
-}
-
-// An empty lane: the world on both sides, no points.
-void padLane(ContactBatch& batch, int lane) {
-  Contact none;
-  none.count = 0;
-  fillLane(batch, lane, none, BodyView{}, BodyView{}, 0, ContactParams{});
 }
 
 }  // namespace
@@ -447,17 +344,19 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   ctx.lane_contact.assign(static_cast<size_t>(batch_at) * kBatchLanes, -1);
 
   // 6. Fill.
-  ContactParams cp;
-  cp.h = h;
-  cp.cfm = s.cfm / h;
-  cp.contact_erp = s.contact_erp;
-  cp.slop = s.slop;
-  cp.threshold = s.restitution_threshold;
-  cp.max_correction = s.max_correction_velocity;
-  cp.warm = s.warm_start ? s.warm_start_factor : Real(0);
-  cp.correction = s.split_impulse ? Correction::PseudoVelocity : s.position_correction;
-  cp.first_substep = first_substep;
-  cp.friction_rows = s.friction_directions;
+  const Correction correction = s.split_impulse ? Correction::PseudoVelocity : s.position_correction;
+  ContactFillParams fp;
+  fp.h = h;
+  fp.cfm = s.cfm / h;
+  fp.contact_erp = s.contact_erp;
+  fp.slop = s.slop;
+  fp.threshold = s.restitution_threshold;
+  fp.max_correction = s.max_correction_velocity;
+  fp.warm = s.warm_start ? s.warm_start_factor : Real(0);
+  fp.in_rhs = correction == Correction::InRhs;
+  fp.first_substep = first_substep;
+  fp.friction_rows = s.friction_directions;
+  const ContactKernels& kernels = contactKernelsFor(s);
   ContactRowSettings crs;
   crs.h = h;
   crs.contact_erp = s.contact_erp;
@@ -465,7 +364,7 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   crs.slop = s.slop;
   crs.restitution_threshold = s.restitution_threshold;
   crs.max_correction_velocity = s.max_correction_velocity;
-  crs.correction = cp.correction;
+  crs.correction = correction;
   crs.warm_start = s.warm_start;
   crs.warm_start_factor = s.warm_start_factor;
   crs.friction_directions = s.friction_directions;
@@ -528,19 +427,25 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   // Each batch is filled and factored on its own, so the batches are split
   // among the pool's threads when there are enough of them (a batch is
   // about a microsecond of work, as much as handing a loop over).
+  // Each batch's manifolds and bodies are gathered lane by lane into one
+  // input (6.7 KB, on the thread's stack: it stays in the cache), which the
+  // fill kernel turns into the lanes W at a time (AVX-512: the eight at
+  // once, where a lane alone was a sixth of an awake pyramid's step).
   const auto fillBatches = [&](int begin, int end) {
+    ContactBatchInput in;
     for (int bi = begin; bi < end; ++bi) {
       ContactBatch& batch = g.batches[static_cast<size_t>(bi)];
       for (int lane = 0; lane < kBatchLanes; ++lane) {
         const std::int32_t ci = ctx.lane_contact[static_cast<size_t>(bi) * kBatchLanes + static_cast<size_t>(lane)];
-        if (ci < 0) {  // the rest of a colour's last batch
-          padLane(batch, lane);
+        if (ci < 0) {  // the rest of a colour's last batch: the world on both sides, no points
+          gatherLane(in, batch, lane, Contact{}, BodyView{}, BodyView{}, 0);
           continue;
         }
         const Contact& con = w.contacts_[static_cast<size_t>(ci)];
-        fillLane(batch, lane, con, solverView(w, ctx, con.body_a), solverView(w, ctx, con.body_b), batch.island[lane],
-                 cp);
+        gatherLane(in, batch, lane, con, solverView(w, ctx, con.body_a), solverView(w, ctx, con.body_b),
+                   batch.island[lane]);
       }
+      kernels.fill(batch, in, fp);
       factorBatch(batch);
       invertRowMasses(batch);
     }

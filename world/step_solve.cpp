@@ -11,6 +11,14 @@
 
 namespace cairn::detail {
 
+const ContactKernels& contactKernelsFor(const SolverSettings& s) {
+  const SimdLevel level = s.simd == Simd::Portable ? SimdLevel::Portable
+                          : s.simd == Simd::Avx2   ? SimdLevel::Avx2
+                          : s.simd == Simd::Avx512 ? SimdLevel::Avx512
+                                                   : bestSimdLevel();
+  return contactKernels(level);
+}
+
 namespace {
 
 GraphSolveOptions graphOptions(WorldImpl& w, const StepContext& ctx) {
@@ -23,11 +31,7 @@ GraphSolveOptions graphOptions(WorldImpl& w, const StepContext& ctx) {
   o.nncg = s.nncg;
   o.randomize_order = s.randomize_order;
   o.dynamic_end = ctx.dynamic_count + 1;
-  const SimdLevel level = s.simd == Simd::Portable ? SimdLevel::Portable
-                          : s.simd == Simd::Avx2   ? SimdLevel::Avx2
-                          : s.simd == Simd::Avx512 ? SimdLevel::Avx512
-                                                   : bestSimdLevel();
-  o.kernels = &contactKernels(level);
+  o.kernels = &contactKernelsFor(s);
   o.pool = w.pool_.get();
   return o;
 }

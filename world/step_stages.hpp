@@ -26,6 +26,9 @@ void integrateVelocities(WorldImpl& w, StepContext& ctx);
 void prepareConstraints(WorldImpl& w, StepContext& ctx);
 // The velocity solve and the position-correction passes (world/step_solve.cpp).
 void solveConstraints(WorldImpl& w, StepContext& ctx);
+// The contact kernels SolverSettings::simd asks for (the widest the CPU has
+// for auto).
+const ContactKernels& contactKernelsFor(const SolverSettings& s);
 // x += h v, q <- exp(h w) q, with the split-impulse pseudo-velocities.
 void integratePositions(WorldImpl& w, StepContext& ctx);
 // Impulses kept for warm starting, joint feedback, joints that break.

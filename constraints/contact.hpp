@@ -62,7 +62,8 @@ struct Contact {
   Quat made_rotation = Quat::Identity();
   Vec3 made_normal = Vec3::UnitY();
 
-  std::uint64_t key() const {
+  std::uint64_t key() const { return keyOf(shape_a, shape_b, triangle); }
+  static std::uint64_t keyOf(std::int32_t shape_a, std::int32_t shape_b, std::int32_t triangle) {
     return (std::uint64_t(std::uint32_t(shape_a)) << 40) ^ (std::uint64_t(std::uint32_t(shape_b)) << 16) ^
            std::uint64_t(std::uint32_t(triangle + 1) & 0xffff);
   }

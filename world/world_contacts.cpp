@@ -235,12 +235,9 @@ bool collidePair(const WorldImpl& w, int pa, int pb, Real h, Real cos_half_angle
   const Body& bb = w.body(rb.body);
   if (!w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
   // Last step's contacts of this pair. They are sorted by key, whose high
-  // bits are the two shapes: a binary search.
-  Contact probe;
-  probe.shape_a = sa;
-  probe.shape_b = sb;
-  probe.triangle = -1;
-  const auto cached = std::lower_bound(old.begin(), old.end(), probe.key(),
+  // bits are the two shapes: a binary search (for the key alone, not a
+  // default 700-byte Contact made per pair).
+  const auto cached = std::lower_bound(old.begin(), old.end(), Contact::keyOf(sa, sb, -1),
                                        [](const Contact& x, std::uint64_t k) { return x.key() < k; });
   if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were
     for (auto it = cached; it != old.end() && it->shape_a == sa && it->shape_b == sb; ++it) {

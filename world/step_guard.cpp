@@ -206,26 +206,19 @@ void saveStepStart(WorldImpl& w, StepContext& ctx) {
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
     Body& b = w.bodies_[i];
     if (!b.alive) continue;
-    if (!finiteState(b)) {
+    if (finiteState(b)) {
+      ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity, b.asleep};
+    } else {
       // Set through the API since the last step: back to the last good
-      // state. Its island has not moved yet, so this body alone is restored.
+      // state, at rest. Its island has not moved yet, so this body alone
+      // is restored.
       const char* what = badField(b);
       restoreBody(w, ctx, i);
       w.numerical_events_.push_back({w.step_count_, w.bodyId(static_cast<int>(i)), b.name, "step start", -1, 1,
                                      std::string(what) + " set between steps"});
-      // The step starts from the last good state as saved, velocities and all.
-      if (b.isDynamic()) {
-        const StepContext::SavedState& st = ctx.step_start[i];
-        const Mat3 r = st.q.toRotationMatrix();
-        ctx.start_energy[i] = Real(0.5) * b.mass * st.v.squaredNorm() +
-                              Real(0.5) * st.w.dot(r * (b.inertia_body * (r.transpose() * st.w))) -
-                              b.mass * w.gravity_.dot(st.x);
-      }
-      continue;
     }
-    ctx.step_start[i] = {b.position, b.orientation, b.linear_velocity, b.angular_velocity, b.asleep};
-    // At rest (every sleeping body) T is +0 to the bit, without reading the
-    // body's rotation and inertia.
+    // T + V as the step begins. At rest (every sleeping body) T is +0 to the
+    // bit, without reading the body's rotation and inertia.
     if (b.isDynamic()) {
       const bool rest = b.linear_velocity == Vec3::Zero() && b.angular_velocity == Vec3::Zero();
       ctx.start_energy[i] = (rest ? Real(0) : b.kineticEnergy()) - b.mass * w.gravity_.dot(b.position);

@@ -787,9 +787,14 @@ struct Kernel {
           rhs = sel(rhs < push, push, rhs);  // std::max's choice, NaN included
           st(q.bias + o, zero_);
         } else {
+          // Every point of the manifold takes part in the correction pass
+          // (target 0 within the slop, -gap/h while separated), so pushing
+          // one corner out lifts the body instead of tipping it.
           put(q.bias, sel(sep > 0, -sep / h, push));  // > 0: being pushed out
         }
         put(q.rhs, rhs);
+        // Restitution: the approach speed at detection, before this step's
+        // forces, applied once after the solve (the restitution kernel).
         const D approach = ld(ip.approach_speed + o), e = ld(in.restitution + o);
         const M bounces = (e > 0) & (-approach > splat(p.threshold));
         put(q.bounce, sel(bounces, -e * approach, zero_));
@@ -797,8 +802,9 @@ struct Kernel {
         put(q.lambda, splat(p.warm) * ld(ip.normal_impulse + o));
 
         // Friction: the first tangent along the sliding direction when
-        // sliding, else along the carried friction impulse, else any
-        // perpendicular (Eigen's anyPerpendicular: n x (x or y), normalised).
+        // sliding, so the pyramid's corners do not favour axes; else along
+        // the carried friction impulse, else any perpendicular
+        // (anyPerpendicular in cairn/math.hpp: n x (x or y), normalised).
         const V3 vrel = sub(add(vb, cross(wb, rb)), add(va, cross(wa, ra)));
         const V3 vt = sub(vrel, mul(n, dot(n, vrel)));
         const V3 fi = ld3(ip.friction_impulse, o);
@@ -817,6 +823,8 @@ struct Kernel {
         const D rv = vsqrt(sel(sliding, vt2, one));
         t1 = sel3(sliding, V3{vt.x / rv, vt.y / rv, vt.z / rv}, t1);
         put3(q.t, t1);
+        // A tangent row left out keeps a zero effective mass: no row (the
+        // residual, the statistics and the exported rows skip it).
         const M rubs = ok & (mu > 0);
         for (int k2 = 0; k2 < 2; ++k2) {
           const bool row = k2 < p.friction_rows;

@@ -62,7 +62,7 @@ int tri(int i, int j) { return i * (i + 1) / 2 + j; }
 // factorBlock). The lanes are the inner loop: a factor is a chain of four
 // square roots and six divisions, each waiting for the last, and eight
 // independent chains side by side keep the divider busy where one chain
-// left it waiting (a fifth of fillLane's time when each lane was factored
+// left it waiting (a fifth of the scalar fill's time when each lane was factored
 // alone). Each lane's arithmetic is the same as alone, so are its bits.
 void factorBatch(ContactBatch& b) {
   double eps[kBatchLanes];
@@ -81,7 +81,7 @@ void factorBatch(ContactBatch& b) {
 }
 
 // The effective masses 1 / (A_ii + cfm) of a batch's rows, from the
-// diagonals fillLane left in their place (0: no row), lanes innermost for
+// diagonals the fill kernel left in their place (0: no row), lanes innermost for
 // the same reason as factorBatch.
 void invertRowMasses(ContactBatch& b) {
   for (int i = 0; i < kMaxPoints; ++i) {

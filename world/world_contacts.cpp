@@ -78,7 +78,8 @@ bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::in
   if (!((now.offset - o.made_offset).squaredNorm() <= s.recycle_distance * s.recycle_distance)) return false;
   // The angle between two rotations: |q1 . q2| = cos(angle / 2).
   if (!(std::abs(now.rotation.coeffs().dot(o.made_rotation.coeffs())) >= cos_half_angle)) return false;
-  Contact c = o;
+  out.push_back(o);  // made in place: one copy of the 700-byte manifold, not two
+  Contact& c = out.back();
   c.enabled = true;  // the callback decides again
   c.carried = true;
   c.normal = ba.orientation * o.made_normal;
@@ -90,7 +91,6 @@ bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::in
     p.depth = (on_a - on_b).dot(c.normal);
     p.approach_speed = c.normal.dot(bb.velocityAt(on_b) - ba.velocityAt(on_a));
   }
-  out.push_back(c);
   return true;
 }
 

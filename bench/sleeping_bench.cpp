@@ -5,8 +5,16 @@
 // (every box asleep after sleep_time).
 //
 //   ./build/bench/cairn_bench --benchmark_filter=RestingBoxes
+//
+// And what a step costs once a pile has gone to sleep: pile-1000 dropped
+// into a heap and stepped until every box sleeps (300 steps; it sleeps at
+// step 162), then one World::step of the sleeping heap, its contacts kept
+// as they are (docs/performance.md).
+//
+//   ./build/bench/cairn_bench --benchmark_filter=AsleepPile
 #include "validation/scenarios.hpp"
 
+#include "cairn/scene.hpp"
 #include "cairn/world.hpp"
 
 #include <benchmark/benchmark.h>
@@ -36,6 +44,17 @@ void BM_RestingBoxes(benchmark::State& state) {
   state.counters["contacts"] = w.lastStepStats().contacts;
 }
 BENCHMARK(BM_RestingBoxes)->ArgName("sleeping")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_AsleepPile1000(benchmark::State& state) {
+  SceneDesc scene = scenarios::pile(10);
+  scene.solver.sleeping = true;
+  World w = buildWorld(scene);
+  for (int i = 0; i < 300; ++i) w.step(scene.dt);
+  for (auto _ : state) w.step(scene.dt);
+  state.counters["sleeping_bodies"] = w.lastStepStats().sleeping_bodies;
+  state.counters["contacts"] = w.lastStepStats().contacts;
+}
+BENCHMARK(BM_AsleepPile1000)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace cairn::bench

@@ -75,6 +75,7 @@
 #include "collision/aabb.hpp"
 #include "constraints/parts.hpp"
 #include "dynamics/forces.hpp"
+#include "world/parallel_thresholds.hpp"
 #include "world/step_stages.hpp"
 
 #include <algorithm>
@@ -210,12 +211,6 @@ void addSupport(const WorldImpl& w, StepContext& ctx, const Contact& c, Real dep
   const Real stays = depth > 0 && depth <= w.settings_.slop ? depth : Real(0);
   ctx.supports.push_back({sinks ? lower.index : -1, upper.index, stays});
 }
-
-// Contacts below which the watchers stay on the calling thread. A depth is
-// a few tens of nanoseconds, and a worker idle since the solve may have to
-// be woken: with 256, pile-1000's guards went from 0.08 to 0.14 ms/step on
-// two threads.
-constexpr int kParallelContacts = 4096;
 
 // Returns the deepest overlap of any contact (StepStats::max_penetration):
 // one pass over the contacts serves the statistic, the watcher and the

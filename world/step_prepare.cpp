@@ -24,6 +24,7 @@
 // colouring, never on the instruction set or the thread count.
 // docs/performance.md measures the order against Box2D's plain greedy
 // colouring and against one colour per constraint.
+#include "world/parallel_thresholds.hpp"
 #include "world/step_stages.hpp"
 
 #include <algorithm>
@@ -90,11 +91,6 @@ void invertRowMasses(ContactBatch& b) {
       for (int l = 0; l < kBatchLanes; ++l) m[l] = m[l] > 0 ? 1 / m[l] : Real(0);
   }
 }
-
-// Batches below which the lanes are filled on the calling thread: at about
-// a microsecond a batch, sixteen split over two threads outweigh the
-// handover (solver/graph_solver.cpp measures the same trade for the solve).
-constexpr int kParallelBatches = 16;
 
 // One manifold and its bodies into one lane of the fill kernel's input
 // (solver/contact_batch.hpp lists the fields; the kernel makes the lane).

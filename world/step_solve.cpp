@@ -4,6 +4,7 @@
 // kept for warm starting, joint feedback and breaking; restitution.
 #include "solver/lcp_exact.hpp"
 #include "solver/lcp_residual.hpp"
+#include "world/parallel_thresholds.hpp"
 #include "world/step_stages.hpp"
 
 #include <algorithm>
@@ -186,11 +187,6 @@ void applyRestitution(WorldImpl& w, StepContext& ctx) {
 }
 
 namespace {
-
-// Lane slots below which the impulses are stored on the calling thread (a
-// few nanoseconds each, against waking a worker; with 256, pyramid-20's
-// store doubled on two threads).
-constexpr int kParallelLanes = 4096;
 
 // One manifold lane's impulses back into its contact (nothing for padding
 // or a stopped island).

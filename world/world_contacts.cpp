@@ -4,6 +4,7 @@
 #include "cairn/error.hpp"
 #include "collision/aabb.hpp"
 #include "collision/narrowphase.hpp"
+#include "world/parallel_thresholds.hpp"
 #include "world/step_stages.hpp"
 
 #include <algorithm>
@@ -191,15 +192,6 @@ Real WorldImpl::contactDepth(const Contact& c) const {
 }
 
 namespace {
-// Pairs below which collide stays on the calling thread. A fresh
-// narrowphase call is 0.2 to 2 us, but a resting pair is recycled or kept
-// for a tenth of that, and the second thread's contacts are then copied
-// into the list (704 bytes each) after a worker that may have gone to
-// sleep since the last step's solve was woken: with 64, an awake
-// pyramid-20 (590 pairs, most recycled) collided in 0.056 ms on two
-// threads against 0.038 on one, while the 5,050-box pyramid (15,000
-// pairs) went from 13.9 to 9.2 ms.
-constexpr int kParallelPairs = 1024;
 
 // A pair of bodies of which nothing moves this step: both asleep or not
 // dynamic, one asleep. Its contacts stay as they were.

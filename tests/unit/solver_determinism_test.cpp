@@ -13,6 +13,7 @@
 #include "solver/contact_kernels.hpp"
 #include "test_helpers.hpp"
 #include "validation/scenarios.hpp"
+#include "world/parallel_thresholds.hpp"
 
 #include <gtest/gtest.h>
 
@@ -66,14 +67,38 @@ TEST(Determinism, ChainAndRagdollAreBitIdenticalOnOneTwoAndFourThreads) {
   }
 }
 
-// 125 boxes dropped into a heap: hundreds of fresh pairs every step through
-// the narrowphase and new manifolds into the batches, where the threads
-// split the pairs and the lanes (a resting pyramid mostly recycles).
+// 125 boxes dropped into a heap: fresh pairs every step through the
+// narrowphase and new manifolds into the batches (a resting pyramid mostly
+// recycles); the solve's colours are split among the threads.
 TEST(Determinism, FallingPileIsBitIdenticalOnOneTwoAndFourThreads) {
   const SceneDesc s = scenarios::pile(5);
   const auto one = run(s, 60, 1, Simd::Auto);
   expectIdentical(one, run(s, 60, 2, Simd::Auto));
   expectIdentical(one, run(s, 60, 4, Simd::Auto));
+}
+
+// The scenes above stay below the thresholds past which collide, the batch
+// fill, the impulse store and the watchers hand their loops to the pool
+// (world/parallel_thresholds.hpp). A pyramid of base 60 (1,830 boxes,
+// about 5,400 touching manifolds) is past all four from its first step,
+// which the test checks before it compares 10 steps on 1, 2 and 4 threads.
+TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
+  const SceneDesc s = scenarios::pyramid(60);
+  {
+    SceneDesc threaded = s;
+    threaded.solver.threads = 2;
+    World w = buildWorld(threaded);
+    w.step(s.dt);
+    const detail::WorldImpl& in = detail::internals(w);
+    const auto batches = static_cast<int>(in.stepContext().graph.batches.size());
+    ASSERT_GE(static_cast<int>(in.pairs_.size()), detail::kParallelPairs);
+    ASSERT_GE(batches, detail::kParallelBatches);
+    ASSERT_GE(batches * kBatchLanes, detail::kParallelLanes);
+    ASSERT_GE(static_cast<int>(in.contacts().size()), detail::kParallelContacts);
+  }
+  const auto one = run(s, 10, 1, Simd::Auto);
+  expectIdentical(one, run(s, 10, 2, Simd::Auto));
+  expectIdentical(one, run(s, 10, 4, Simd::Auto));
 }
 
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {

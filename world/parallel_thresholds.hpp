@@ -1,0 +1,46 @@
+// Work below which a stage stays on the calling thread when the World has
+// a worker pool (SolverSettings::threads > 1). Handing a loop over wakes a
+// worker that may have slept since the last solve and ends at a barrier;
+// each threshold is where that began to pay on the shared 2-core machine,
+// measured as its comment says. The solve's colours have their own rule
+// (solver/graph_solver.cpp). Results never depend on them: the threads
+// split a loop's items and every reduction runs in storage order on one
+// thread (tests/unit/solver_determinism_test.cpp runs a scene past all
+// four on 1, 2 and 4 threads).
+#pragma once
+
+namespace cairn::detail {
+
+// Pairs below which collide (world/world_contacts.cpp: the narrowphase,
+// then the warm-start matching of new contacts) stays on the calling
+// thread. A fresh narrowphase call is 0.2 to 2 us, but a resting pair is
+// recycled or kept for a tenth of that, and the second thread's contacts
+// are then copied into the list (704 bytes each) after a worker that may
+// have gone to sleep since the last step's solve was woken: with 64, an
+// awake pyramid-20 (590 pairs, most recycled) collided in 0.056 ms on two
+// threads against 0.038 on one, while the 5,050-box pyramid (15,000
+// pairs) went from 13.9 to 9.2 ms.
+constexpr int kParallelPairs = 1024;
+
+// Batches below which the lanes are gathered, filled and factored on the
+// calling thread (world/step_prepare.cpp). With the fill kernel a batch
+// takes about half a microsecond, and a stack's batches hold one manifold
+// each: column-20's twenty ran its step 8 to 14% slower on two threads
+// than on one when sixteen batches were handed over, 5% at 64 (`cairn
+// bench column-20 --threads 1|2 --repeat 5`), while pile-1000 (120
+// batches) and the 5,050-box pyramid filled no slower.
+constexpr int kParallelBatches = 64;
+
+// Lane slots below which the impulses are stored on the calling thread
+// (world/step_solve.cpp): a few nanoseconds each, against waking a worker;
+// with 256, pyramid-20's store doubled on two threads.
+constexpr int kParallelLanes = 4096;
+
+// Contacts below which the watchers' depths after the step are found on
+// the calling thread (world/step_diagnostics.cpp). A depth is a few tens
+// of nanoseconds, and a worker idle since the solve may have to be woken:
+// with 256, pile-1000's guards went from 0.08 to 0.14 ms/step on two
+// threads.
+constexpr int kParallelContacts = 4096;
+
+}  // namespace cairn::detail

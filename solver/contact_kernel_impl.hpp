@@ -826,18 +826,28 @@ struct Kernel {
         // A tangent row left out keeps a zero effective mass: no row (the
         // residual, the statistics and the exported rows skip it).
         const M rubs = ok & (mu > 0);
+        const auto rowPut = [&](double* dst, D v) { st(dst + o, sel(rubs, v, zero_)); };
         for (int k2 = 0; k2 < 2; ++k2) {
-          const bool row = k2 < p.friction_rows;
+          if (k2 >= p.friction_rows) {  // not solved: zeros, nothing computed
+            for (int c = 0; c < 3; ++c) {
+              st(q.rat[k2][c] + o, zero_);
+              st(q.rbt[k2][c] + o, zero_);
+            }
+            st(q.tangent_mass[k2] + o, zero_);
+            st(q.lambda_t[k2] + o, zero_);
+            continue;
+          }
           const V3 t = k2 == 0 ? t1 : cross(n, t1);
           const V3 rat = cross(ra, t), rbt = cross(rb, t);
           const D kt = dot(t, cmul(m_ab, t)) + dot(rat, mulM(ia, rat)) + dot(rbt, mulM(ib, rbt));
-          const M on = row ? rubs : M{};
-          for (int c = 0; c < 3; ++c) {
-            st(q.rat[k2][c] + o, sel(on, c == 0 ? rat.x : c == 1 ? rat.y : rat.z, zero_));
-            st(q.rbt[k2][c] + o, sel(on, c == 0 ? rbt.x : c == 1 ? rbt.y : rbt.z, zero_));
-          }
-          st(q.tangent_mass[k2] + o, sel(on, kt + cfm, zero_));  // inverted with the batch (<= 0: no row)
-          st(q.lambda_t[k2] + o, sel(on, splat(p.warm) * dot(fi, t), zero_));
+          rowPut(q.rat[k2][0], rat.x);
+          rowPut(q.rat[k2][1], rat.y);
+          rowPut(q.rat[k2][2], rat.z);
+          rowPut(q.rbt[k2][0], rbt.x);
+          rowPut(q.rbt[k2][1], rbt.y);
+          rowPut(q.rbt[k2][2], rbt.z);
+          rowPut(q.tangent_mass[k2], kt + cfm);  // inverted with the batch (<= 0: no row)
+          rowPut(q.lambda_t[k2], splat(p.warm) * dot(fi, t));
         }
       }
       // The normal block, padded to 4 x 4 with identity rows.

@@ -237,8 +237,8 @@ void updateSleep(WorldImpl& w, StepContext& ctx) {
     for (size_t i = 0; i < w.bodies_.size(); ++i) {
       const std::int32_t isl = ctx.body_island[i];
       if (isl < 0 || island_min[static_cast<size_t>(isl)] < s.sleep_time) continue;
-      Body& b = w.bodies_[i];
-      if (!b.asleep) ++sleeping;
+      Body& b = w.bodies_[i];  // awake: it has an island
+      ++sleeping;
       b.asleep = true;
       b.linear_velocity.setZero();
       b.angular_velocity.setZero();

@@ -118,7 +118,8 @@ void gatherLane(ContactBatchInput& in, ContactBatch& batch, int lane, const Cont
   in.restitution[lane] = c.restitution;
   for (int i = 0; i < kMaxPoints; ++i) {
     ContactBatchInput::Point& q = in.p[i];
-    const ContactPointState s = i < c.count ? c.points[i] : ContactPointState{};
+    static const ContactPointState kNoPoint;  // a point past the count reads as zeros
+    const ContactPointState& s = i < c.count ? c.points[i] : kNoPoint;
     for (int k = 0; k < 3; ++k) {
       q.local_a[k][lane] = s.local_a[k];
       q.local_b[k][lane] = s.local_b[k];

@@ -45,6 +45,7 @@ int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacemen
   p.alive = true;
   p.user = user;
   p.owner = owner;
+  addFilter(p.group, p.mask);
   if (tight.isInfinite()) {
     p.fat = tight;
     infinite_.insert(std::lower_bound(infinite_.begin(), infinite_.end(), h), h);
@@ -68,6 +69,7 @@ void BroadPhase::destroyProxy(int h) {
   }
   p.alive = false;
   p.leaf = -1;
+  filters_stale_ = true;
   p.next_free = free_;
   free_ = h;
   --live_;
@@ -103,6 +105,8 @@ void BroadPhase::setFilter(int h, std::uint32_t group, std::uint32_t mask) {
   if (p.group == group && p.mask == mask) return;
   p.group = group;
   p.mask = mask;
+  addFilter(group, mask);
+  filters_stale_ = true;
   markMoved(h);
 }
 
@@ -126,6 +130,7 @@ void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) 
     p.alive = proxies[i].alive;
     if (!p.alive) continue;
     ++live_;
+    addFilter(p.group, p.mask);
     if (p.fat.isInfinite()) infinite_.push_back(h);
     else p.leaf = tree_.insert(p.fat, h);
     markMoved(h);
@@ -135,6 +140,12 @@ void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) 
 
 bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
   const bool changed = !moved_.empty() || !dirty_.empty();
+  if (filters_stale_) {
+    group_union_ = mask_union_ = 0;
+    for (const Proxy& p : proxies_)
+      if (p.alive) addFilter(p.group, p.mask);
+    filters_stale_ = false;
+  }
   // 1. Pairs found by querying each moved proxy. A query stops at
   //    max_pairs_ other proxies (the bound in the header). A pair of two
   //    moved proxies may be found twice (the sort below keeps one): keeping
@@ -144,7 +155,9 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
   capped_.clear();
   for (int m : moved_) {
     const Proxy& pm = proxies_[m];
-    if (!pm.alive) continue;
+    // A proxy whose filter meets no live proxy's has no pair to find
+    // (the pair test below would reject every overlap).
+    if (!pm.alive || !mayPairWithAny(pm.group, pm.mask)) continue;
     int found = 0;
     auto add = [&](int o) {
       const Proxy& po = proxies_[o];

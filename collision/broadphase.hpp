@@ -76,6 +76,14 @@ class BroadPhase {
   // Collision filter of a proxy (default: group 1, every mask bit set).
   // A change re-pairs the proxy at the next updatePairs.
   void setFilter(int handle, std::uint32_t group, std::uint32_t mask);
+  // Whether a proxy with this filter could pair with any live proxy: its
+  // mask meets some proxy's group and its group some proxy's mask. Kept as
+  // the union of every live filter (a superset between updatePairs calls,
+  // exact after one), so a false answer is always safe: a chain whose links
+  // collide with nothing queries no tree for pairs it would throw away.
+  bool mayPairWithAny(std::uint32_t group, std::uint32_t mask) const {
+    return (mask & group_union_) != 0 && (group & mask_union_) != 0;
+  }
 
   // Every pair of proxies whose fat boxes overlap, each once as (lo, hi)
   // handles with lo < hi, sorted. `out` is overwritten. Returns false when
@@ -166,6 +174,10 @@ class BroadPhase {
 
   Aabb fatten(const Aabb& tight, const Vec3& displacement) const;
   void markMoved(int handle);
+  void addFilter(std::uint32_t group, std::uint32_t mask) {
+    group_union_ |= group;
+    mask_union_ |= mask;
+  }
 
   Real margin_;
   Real displacement_multiplier_;
@@ -179,6 +191,10 @@ class BroadPhase {
   std::vector<std::pair<int, int>> fresh_;  // scratch for updatePairs
   std::vector<int> capped_;
   int max_pairs_ = 64;
+  // OR of the live proxies' groups and masks (mayPairWithAny); a superset
+  // until updatePairs recomputes them after a proxy died or was refiltered.
+  std::uint32_t group_union_ = 0, mask_union_ = 0;
+  bool filters_stale_ = false;
   int free_ = -1;
   int live_ = 0;
   std::uint64_t overlap_tests_ = 0;

@@ -323,6 +323,9 @@ void watchFastBodies(WorldImpl& w, StepContext& ctx) {
     if (!ctx.moves(i)) continue;
     const Body& b = w.bodies_[i];
     if (!b.alive || !b.isDynamic() || b.asleep || b.ccd || b.shapes.empty()) continue;
+    // A body whose filter meets no shape's in the world passes through
+    // everything by design (a chain whose links collide with nothing).
+    if (!w.broadphase_.mayPairWithAny(b.collision_group, b.collision_mask)) continue;
     const Vec3 from = ctx.step_start[i].x, to = b.position;
     const Real travel = (to - from).norm();
     // Cheap test first: a body that moved less than its radius of gyration

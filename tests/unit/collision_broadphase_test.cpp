@@ -161,5 +161,48 @@ TEST(BroadPhasePairs, FilterBitsDecideWhichOverlapsPair) {
   EXPECT_EQ(pairs, (std::vector<std::pair<int, int>>{{a, b}}));
 }
 
+// A proxy whose filter meets no live proxy's cannot pair: its query is not
+// run at all (no box test is counted), and the answer follows the proxies
+// that come, go and change their filters.
+TEST(BroadPhasePairs, ProxyThatCanPairWithNothingIsNotQueried) {
+  BroadPhase bp(0.1);
+  std::vector<std::pair<int, int>> pairs;
+  // A chain's links: group 2, every mask bit but 2's, side by side.
+  std::vector<int> links;
+  for (int i = 0; i < 20; ++i) {
+    links.push_back(bp.createProxy(Aabb::fromCenterHalf(Vec3(0.5 * i, 0, 0), Vec3::Constant(0.4)), i));
+    bp.setFilter(links.back(), 2, ~2u);
+  }
+  bp.resetOverlapTests();
+  bp.updatePairs(pairs);
+  EXPECT_TRUE(pairs.empty());
+  EXPECT_EQ(bp.overlapTests(), 0u);
+  EXPECT_FALSE(bp.mayPairWithAny(2, ~2u));
+  // A ball of group 1 that takes everything: the links may now pair with it.
+  const int ball = bp.createProxy(Aabb::fromCenterHalf(Vec3(0, 0.5, 0), Vec3::Constant(0.3)), 99);
+  EXPECT_TRUE(bp.mayPairWithAny(2, ~2u));
+  bp.updatePairs(pairs);
+  EXPECT_EQ(pairs, (std::vector<std::pair<int, int>>{{links[0], ball}, {links[1], ball}}));
+  // Gone again: exact after the next update, and a moved link is not queried.
+  bp.destroyProxy(ball);
+  bp.updatePairs(pairs);
+  EXPECT_TRUE(pairs.empty());
+  EXPECT_FALSE(bp.mayPairWithAny(2, ~2u));
+  bp.resetOverlapTests();
+  bp.moveProxy(links[3], Aabb::fromCenterHalf(Vec3(9, 0, 0), Vec3::Constant(0.4)));
+  bp.updatePairs(pairs);
+  EXPECT_EQ(bp.overlapTests(), 0u);
+  // A link refiltered to meet the others' group pairs with its neighbours.
+  bp.setFilter(links[10], 2, ~0u);
+  EXPECT_TRUE(bp.mayPairWithAny(2, ~0u));
+  bp.updatePairs(pairs);
+  EXPECT_TRUE(pairs.empty());  // the others' masks still refuse group 2
+  bp.setFilter(links[10], 1, ~0u);
+  bp.updatePairs(pairs);
+  // Fat boxes (half 0.4 + margin 0.1, 0.5 apart) reach two neighbours each way.
+  EXPECT_EQ(pairs, (std::vector<std::pair<int, int>>{
+                       {links[8], links[10]}, {links[9], links[10]}, {links[10], links[11]}, {links[10], links[12]}}));
+}
+
 }  // namespace
 }  // namespace cairn

@@ -145,11 +145,71 @@ void forColour(const GraphColour& c, WorkerPool* pool, Groups&& groups_fn, Batch
   });
 }
 
+// What one thread sweeps: a run of colours with their batches and groups,
+// and the islands they belong to (the whole problem, or one of its parts).
+struct Part {
+  std::int32_t colour_begin = 0, colour_end = 0;
+  std::int32_t batch_begin = 0, batch_end = 0;
+  std::int32_t group_begin = 0, group_end = 0;
+  std::int32_t island_begin = 0, island_end = 0;
+};
+
+Part wholeProblem(const GraphProblem& p) {
+  return {0,
+          static_cast<std::int32_t>(p.colours.size()),
+          0,
+          static_cast<std::int32_t>(p.batches.size()),
+          0,
+          static_cast<std::int32_t>(p.groups.size()),
+          0,
+          p.island_count};
+}
+
+// The parts a solve sweeps; a shuffled colour order (randomize_order) is
+// one order over all colours, so then the whole problem is one part.
+int partCount(const GraphProblem& p, const GraphSolveOptions& o) {
+  return p.part_colour.empty() || o.randomize_order ? 1 : static_cast<int>(p.part_colour.size()) - 1;
+}
+
+Part partOf(const GraphProblem& p, const GraphSolveOptions& o, int k) {
+  if (partCount(p, o) == 1) return wholeProblem(p);
+  Part part;
+  part.colour_begin = p.part_colour[static_cast<size_t>(k)];
+  part.colour_end = p.part_colour[static_cast<size_t>(k) + 1];
+  part.island_begin = p.part_island[static_cast<size_t>(k)];
+  part.island_end = p.part_island[static_cast<size_t>(k) + 1];
+  if (part.colour_end > part.colour_begin) {
+    const GraphColour& first = p.colours[static_cast<size_t>(part.colour_begin)];
+    const GraphColour& last = p.colours[static_cast<size_t>(part.colour_end) - 1];
+    part = {part.colour_begin, part.colour_end, first.batch_begin, last.batch_end, first.group_begin,
+            last.group_end,    part.island_begin, part.island_end};
+  }
+  return part;
+}
+
+// Runs fn(k, part k, options) for every part: side by side on the pool's
+// threads when there are several (each then sweeps its colours alone, with
+// no pool of its own), else on the calling thread with the pool for the
+// colours.
+template <class F>
+void forParts(const GraphProblem& p, const GraphSolveOptions& o, F&& fn) {
+  const int parts = partCount(p, o);
+  if (parts == 1 || !o.pool) {
+    for (int k = 0; k < parts; ++k) fn(k, partOf(p, o, k), o);
+    return;
+  }
+  GraphSolveOptions alone = o;
+  alone.pool = nullptr;
+  o.pool->parallelFor(parts, [&](int begin, int end) {
+    for (int k = begin; k < end; ++k) fn(k, partOf(p, o, k), alone);
+  });
+}
+
 // Each island's largest change and impulse of the sweep, gathered in
 // storage order (the same whatever the threads did).
-void reduceSweep(GraphProblem& p, bool contacts) {
-  std::fill(p.island_delta.begin(), p.island_delta.end(), 0.0);
-  std::fill(p.island_lambda.begin(), p.island_lambda.end(), 0.0);
+void reduceSweep(GraphProblem& p, const Part& part, bool contacts) {
+  std::fill(p.island_delta.begin() + part.island_begin, p.island_delta.begin() + part.island_end, 0.0);
+  std::fill(p.island_lambda.begin() + part.island_begin, p.island_lambda.begin() + part.island_end, 0.0);
   const auto fold = [&](std::int32_t island, double delta, double lambda) {
     const size_t i = static_cast<size_t>(island);
     // NaN must win: a non-finite island never looks converged.
@@ -157,18 +217,24 @@ void reduceSweep(GraphProblem& p, bool contacts) {
     if (!(p.island_lambda[i] >= lambda)) p.island_lambda[i] = lambda;
   };
   if (contacts)
-    for (const ContactBatch& b : p.batches)
+    for (std::int32_t bi = part.batch_begin; bi < part.batch_end; ++bi) {
+      const ContactBatch& b = p.batches[static_cast<size_t>(bi)];
       for (int l = 0; l < kBatchLanes; ++l)
         if (b.count[l] > 0 && active(p, b.island[l])) fold(b.island[l], b.sweep_delta[l], b.sweep_lambda[l]);
-  for (size_t g = 0; g < p.groups.size(); ++g)
-    if (active(p, p.groups[g].island)) fold(p.groups[g].island, p.group_delta[g], p.group_lambda[g]);
+    }
+  for (std::int32_t g = part.group_begin; g < part.group_end; ++g) {
+    const RowGroup& grp = p.groups[static_cast<size_t>(g)];
+    if (active(p, grp.island))
+      fold(grp.island, p.group_delta[static_cast<size_t>(g)], p.group_lambda[static_cast<size_t>(g)]);
+  }
 }
 
 // Stops the islands that reached the tolerance or a round-off fixed point;
 // returns whether any island goes on.
-bool stopConverged(GraphProblem& p, const GraphSolveOptions& o, int sweeps) {
+bool stopConverged(GraphProblem& p, const Part& part, const GraphSolveOptions& o, int sweeps) {
   bool any = false;
-  for (size_t i = 0; i < p.island_active.size(); ++i) {
+  for (std::int32_t k = part.island_begin; k < part.island_end; ++k) {
+    const size_t i = static_cast<size_t>(k);
     if (p.island_active[i] == 0) continue;
     p.island_iterations[i] = sweeps;
     const double d = p.island_delta[i];
@@ -180,17 +246,22 @@ bool stopConverged(GraphProblem& p, const GraphSolveOptions& o, int sweeps) {
 
 // beta per island from this sweep's squared change (summed in storage
 // order); -1 for islands that have stopped.
-void islandBetas(GraphProblem& p) {
-  std::fill(p.island_norm2.begin(), p.island_norm2.end(), 0.0);
-  for (const ContactBatch& b : p.batches)
+void islandBetas(GraphProblem& p, const Part& part) {
+  std::fill(p.island_norm2.begin() + part.island_begin, p.island_norm2.begin() + part.island_end, 0.0);
+  for (std::int32_t bi = part.batch_begin; bi < part.batch_end; ++bi) {
+    const ContactBatch& b = p.batches[static_cast<size_t>(bi)];
     for (int l = 0; l < kBatchLanes; ++l)
       if (b.count[l] > 0) p.island_norm2[static_cast<size_t>(b.island[l])] += b.change2[l];
-  for (const RowGroup& g : p.groups)
+  }
+  for (std::int32_t gi = part.group_begin; gi < part.group_end; ++gi) {
+    const RowGroup& g = p.groups[static_cast<size_t>(gi)];
     for (std::int32_t i = g.begin; i < g.end; ++i) {
       const Real d = p.row_change[static_cast<size_t>(i)];
       p.island_norm2[static_cast<size_t>(g.island)] += d * d;
     }
-  for (size_t i = 0; i < p.island_norm2.size(); ++i) {
+  }
+  for (std::int32_t k = part.island_begin; k < part.island_end; ++k) {
+    const size_t i = static_cast<size_t>(k);
     if (p.island_active[i] == 0) {
       p.island_beta[i] = -1;
       continue;
@@ -201,12 +272,14 @@ void islandBetas(GraphProblem& p) {
   }
 }
 
-void orderColours(GraphProblem& p, bool randomize, std::uint64_t& rng_state) {
-  const size_t n = p.colours.size();
-  p.colour_order.resize(n);
-  for (size_t i = 0; i < n; ++i) p.colour_order[i] = static_cast<std::int32_t>(i);
+// The order of this sweep's colours: the part's in order, or (whole
+// problem only) a seeded shuffle of all of them.
+void orderColours(std::vector<std::int32_t>& order, const Part& part, bool randomize, std::uint64_t& rng_state) {
+  const size_t n = static_cast<size_t>(part.colour_end - part.colour_begin);
+  order.resize(n);
+  for (size_t i = 0; i < n; ++i) order[i] = part.colour_begin + static_cast<std::int32_t>(i);
   if (randomize)
-    for (size_t i = n; i > 1; --i) std::swap(p.colour_order[i - 1], p.colour_order[nextRandom(rng_state) % i]);
+    for (size_t i = n; i > 1; --i) std::swap(order[i - 1], order[nextRandom(rng_state) % i]);
 }
 
 void startSweeps(GraphProblem& p) {
@@ -219,20 +292,19 @@ void startSweeps(GraphProblem& p) {
   p.group_lambda.assign(p.groups.size(), Real(0));
 }
 
-}  // namespace
-
-GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const GraphSolveOptions& o,
-                           std::uint64_t& rng_state) {
+// Warm start and the velocity sweeps of one part. `order` is this part's
+// own colour order (parts never randomize: the step makes none then).
+GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::int32_t>& order,
+                          std::span<SolverBody> bodies, const GraphSolveOptions& o, std::uint64_t& rng_state) {
   GraphSolveStats stats;
-  if (p.empty()) return stats;
   double* body_data = bodies.front().v.data();
-  startSweeps(p);
+  const auto colour = [&](std::int32_t ci) -> const GraphColour& { return p.colours[static_cast<size_t>(ci)]; };
 
   // Warm start: the carried impulses act before the first sweep.
   const ContactSweepParams warm = sweepParams(p, o, false);
-  for (const GraphColour& c : p.colours)
+  for (std::int32_t ci = part.colour_begin; ci < part.colour_end; ++ci)
     forColour(
-        c, o.pool,
+        colour(ci), o.pool,
         [&](std::int32_t gi) {
           const RowGroup& g = p.groups[static_cast<size_t>(gi)];
           for (std::int32_t k = g.begin; k < g.end; ++k) {
@@ -242,6 +314,48 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
         },
         [&](int b0, int b1) { o.kernels->warm_start(p.batches.data(), b0, b1, body_data, warm); });
 
+  const ContactSweepParams sp = sweepParams(p, o, o.nncg);
+  const bool batches = part.batch_end > part.batch_begin;
+  for (int it = 0; it < o.iterations; ++it) {
+    if (o.randomize_order || it == 0) orderColours(order, part, o.randomize_order, rng_state);
+    for (const std::int32_t ci : order)
+      forColour(
+          colour(ci), o.pool, [&](std::int32_t gi) { solveGroup(p, gi, bodies, o, o.nncg); },
+          [&](int b0, int b1) { o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, sp); });
+    if (batches)  // a jointed scene without contacts has no friction pass to walk
+      for (const std::int32_t ci : order)
+        forColour(
+            colour(ci), o.pool, [](std::int32_t) {},
+            [&](int b0, int b1) { o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); });
+    reduceSweep(p, part, true);
+    stats.last_max_delta = 0;
+    for (std::int32_t i = part.island_begin; i < part.island_end; ++i)
+      if (p.island_active[static_cast<size_t>(i)] > 0)
+        stats.last_max_delta = std::max(stats.last_max_delta, p.island_delta[static_cast<size_t>(i)]);
+    stats.iterations = it + 1;
+    if (!stopConverged(p, part, o, it + 1)) break;
+    // No momentum after the last sweep: the result must be a PGS iterate.
+    if (o.nncg && it + 1 < o.iterations) {
+      islandBetas(p, part);
+      for (const std::int32_t ci : order)
+        forColour(
+            colour(ci), o.pool,
+            [&](std::int32_t gi) { groupMomentum(p, p.groups[static_cast<size_t>(gi)], bodies, o.dynamic_end); },
+            [&](int b0, int b1) {
+              o.kernels->momentum(p.batches.data(), b0, b1, body_data, p.island_beta.data(), sp);
+            });
+    }
+  }
+  return stats;
+}
+
+}  // namespace
+
+GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const GraphSolveOptions& o,
+                           std::uint64_t& rng_state) {
+  GraphSolveStats stats;
+  if (p.empty()) return stats;
+  startSweeps(p);
   if (o.nncg) {
     p.row_change.assign(p.rows.size(), Real(0));
     p.row_dir.assign(p.rows.size(), Real(0));
@@ -250,36 +364,17 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
     p.island_prev_norm2.assign(n, 0.0);
     p.island_beta.assign(n, 0.0);
   }
-  const ContactSweepParams sp = sweepParams(p, o, o.nncg);
-  for (int it = 0; it < o.iterations; ++it) {
-    orderColours(p, o.randomize_order, rng_state);
-    for (const std::int32_t ci : p.colour_order)
-      forColour(
-          p.colours[static_cast<size_t>(ci)], o.pool, [&](std::int32_t gi) { solveGroup(p, gi, bodies, o, o.nncg); },
-          [&](int b0, int b1) { o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, sp); });
-    if (!p.batches.empty())  // a jointed scene without contacts has no friction pass to walk
-      for (const std::int32_t ci : p.colour_order)
-        forColour(
-            p.colours[static_cast<size_t>(ci)], o.pool, [](std::int32_t) {},
-            [&](int b0, int b1) { o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); });
-    reduceSweep(p, true);
-    stats.last_max_delta = 0;
-    for (size_t i = 0; i < p.island_active.size(); ++i)
-      if (p.island_active[i] > 0) stats.last_max_delta = std::max(stats.last_max_delta, p.island_delta[i]);
-    if (!stopConverged(p, o, it + 1)) break;
-    // No momentum after the last sweep: the result must be a PGS iterate.
-    if (o.nncg && it + 1 < o.iterations) {
-      islandBetas(p);
-      for (const std::int32_t ci : p.colour_order)
-        forColour(
-            p.colours[static_cast<size_t>(ci)], o.pool,
-            [&](std::int32_t gi) { groupMomentum(p, p.groups[static_cast<size_t>(gi)], bodies, o.dynamic_end); },
-            [&](int b0, int b1) {
-              o.kernels->momentum(p.batches.data(), b0, b1, body_data, p.island_beta.data(), sp);
-            });
-    }
-  }
+  const int parts = partCount(p, o);
+  p.part_stats.assign(static_cast<size_t>(parts), GraphSolveStats{});
+  p.part_order.resize(static_cast<size_t>(parts));
+  forParts(p, o, [&](int k, const Part& part, const GraphSolveOptions& po) {
+    p.part_stats[static_cast<size_t>(k)] = sweepPart(p, part, p.part_order[static_cast<size_t>(k)], bodies, po, rng_state);
+  });
+  // The sweeps ended with the part that swept longest: its islands'
+  // largest change is the last sweep's (as one part would report it).
   for (const int n : p.island_iterations) stats.iterations = std::max(stats.iterations, n);
+  for (const GraphSolveStats& st : p.part_stats)
+    if (st.iterations == stats.iterations) stats.last_max_delta = std::max(stats.last_max_delta, st.last_max_delta);
   return stats;
 }
 
@@ -324,22 +419,25 @@ void biasGroup(GraphProblem& p, std::int32_t gi, std::span<SolverBody> bodies, C
 }
 
 // One correction pass (pgs.cpp's solvePgsCorrection, by colour and with
-// blocks for the contact normals), each island stopping on its own.
+// blocks for the contact normals), each island stopping on its own, each
+// part on its own thread.
 void biasPass(GraphProblem& p, std::span<SolverBody> bodies, Correction which, bool contacts,
               const GraphSolveOptions& o) {
   startSweeps(p);
   double* body_data = bodies.front().v.data();
   const ContactSweepParams sp = sweepParams(p, o, false);
-  for (int it = 0; it < o.iterations; ++it) {
-    for (const GraphColour& c : p.colours)
-      forColour(
-          c, o.pool, [&](std::int32_t gi) { biasGroup(p, gi, bodies, which, o); },
-          [&](int b0, int b1) {
-            if (contacts) o.kernels->solve_bias(p.batches.data(), b0, b1, body_data, sp);
-          });
-    reduceSweep(p, contacts);
-    if (!stopConverged(p, o, it + 1)) break;
-  }
+  forParts(p, o, [&](int, const Part& part, const GraphSolveOptions& po) {
+    for (int it = 0; it < po.iterations; ++it) {
+      for (std::int32_t ci = part.colour_begin; ci < part.colour_end; ++ci)
+        forColour(
+            p.colours[static_cast<size_t>(ci)], po.pool, [&](std::int32_t gi) { biasGroup(p, gi, bodies, which, po); },
+            [&](int b0, int b1) {
+              if (contacts) po.kernels->solve_bias(p.batches.data(), b0, b1, body_data, sp);
+            });
+      reduceSweep(p, part, contacts);
+      if (!stopConverged(p, part, po, it + 1)) break;
+    }
+  });
 }
 
 }  // namespace

@@ -44,6 +44,11 @@ struct RowGroup {
   std::int32_t island = 0;
 };
 
+struct GraphSolveStats {
+  int iterations = 0;       // the most sweeps any island took
+  Real last_max_delta = 0;  // the largest impulse change of the islands' last sweeps
+};
+
 struct GraphColour {
   std::int32_t batch_begin = 0, batch_end = 0;  // ContactBatch range
   std::int32_t group_begin = 0, group_end = 0;  // RowGroup range
@@ -57,6 +62,15 @@ struct GraphProblem {
   std::vector<ConstraintRow> rows;    // the groups' rows
   std::vector<GraphColour> colours;
   int island_count = 0;
+  // Parts solved side by side, each on one thread with no barrier between
+  // its colours: part k is the colours [part_colour[k], part_colour[k + 1])
+  // and the islands [part_island[k], part_island[k + 1]), and no constraint
+  // of one part touches an island of another. Empty: one part, every
+  // colour split among the threads instead (a scene of one large island).
+  // An island's constraints are coloured the same either way, and islands
+  // never share a sweep's result (each stops on its own, with its own
+  // momentum), so the parts change nothing but which thread does the work.
+  std::vector<std::int32_t> part_colour, part_island;
 
   // Scratch, sized by the solver.
   std::vector<Real> row_change, row_dir, row_bias_lambda;
@@ -65,7 +79,8 @@ struct GraphProblem {
   std::vector<double> island_active;            // 1 while the island's sweeps go on
   std::vector<double> island_delta, island_lambda;
   std::vector<int> island_iterations;
-  std::vector<std::int32_t> colour_order;
+  std::vector<std::vector<std::int32_t>> part_order;  // per part: its sweep's colour order
+  std::vector<GraphSolveStats> part_stats;
 
   void clear() {
     batches.clear();
@@ -73,6 +88,8 @@ struct GraphProblem {
     rows.clear();
     colours.clear();
     island_count = 0;
+    part_colour.clear();
+    part_island.clear();
   }
   bool empty() const { return batches.empty() && groups.empty(); }
 };
@@ -87,11 +104,6 @@ struct GraphSolveOptions {
   int friction_rows = 2;  // tangent rows per contact point
   const ContactKernels* kernels = nullptr;
   WorkerPool* pool = nullptr;  // null: this thread only
-};
-
-struct GraphSolveStats {
-  int iterations = 0;       // the most sweeps any island took
-  Real last_max_delta = 0;  // the largest impulse change of the islands' last sweeps
 };
 
 // Warm start and the velocity sweeps.

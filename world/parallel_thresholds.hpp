@@ -6,7 +6,7 @@
 // (solver/graph_solver.cpp). Results never depend on them: the threads
 // split a loop's items and every reduction runs in storage order on one
 // thread (tests/unit/solver_determinism_test.cpp runs a scene past all
-// four on 1, 2 and 4 threads).
+// five on 1, 2 and 4 threads).
 #pragma once
 
 namespace cairn::detail {
@@ -42,5 +42,11 @@ constexpr int kParallelLanes = 4096;
 // with 256, pile-1000's guards went from 0.08 to 0.14 ms/step on two
 // threads.
 constexpr int kParallelContacts = 4096;
+
+// Constraints (manifolds and joints) below which the PGS islands are not
+// split into parts, one per thread (world/step_prepare.cpp): a part's
+// sweeps are handed over once per solve, a few microseconds against the
+// tens that 64 constraints take to sweep ten times.
+constexpr int kParallelPartItems = 64;
 
 }  // namespace cairn::detail

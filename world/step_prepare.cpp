@@ -266,8 +266,53 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
       head = bfs(head);
     }
 
-  // 3. Sort by level (joints before contacts within a level, then creation
-  // order: `items` is in that order already, so a stable counting sort).
+  // 3. Parts: with a worker pool, the islands in as many contiguous runs as
+  // there are threads, of about equal numbers of constraints, each swept
+  // by one thread from start to end with no barrier between its colours
+  // (graph_solver.hpp). Each colour otherwise ends at a barrier of both
+  // threads, a microsecond or so on this machine: pile-1000's ten colours
+  // met at 400 barriers a step. One island holding most of the work (a
+  // pyramid, a column) keeps the one part whose colours the threads split.
+  const int threads = w.pool_ ? w.pool_->threads() : 1;
+  int parts = 1;
+  std::vector<std::int32_t>& island_part = ctx.island_part;
+  if (threads > 1 && !s.randomize_order && static_cast<int>(items.size()) >= kParallelPartItems) {
+    std::vector<std::int32_t>& work = ctx.island_work;
+    work.assign(static_cast<size_t>(ctx.island_count), 0);
+    for (const Item& it : items) ++work[static_cast<size_t>(it.island)];
+    const auto total = static_cast<std::int64_t>(items.size());
+    g.part_island.assign(static_cast<size_t>(threads) + 1, ctx.island_count);
+    g.part_island[0] = 0;
+    std::int64_t done = 0;
+    int next = 1;
+    for (std::int32_t isl = 0; isl < ctx.island_count; ++isl) {
+      done += work[static_cast<size_t>(isl)];
+      while (next < threads && done * threads >= total * next) g.part_island[static_cast<size_t>(next++)] = isl + 1;
+    }
+    std::int64_t largest = 0;
+    for (int k = 0; k < threads; ++k) {
+      std::int64_t in = 0;
+      for (std::int32_t isl = g.part_island[static_cast<size_t>(k)]; isl < g.part_island[static_cast<size_t>(k) + 1]; ++isl)
+        in += work[static_cast<size_t>(isl)];
+      largest = std::max(largest, in);
+    }
+    // At most a fifth over an even share: else the longest part would
+    // keep the other threads waiting longer than the barriers cost.
+    if (largest * threads * 5 <= total * 6) {
+      parts = threads;
+      island_part.assign(static_cast<size_t>(ctx.island_count), 0);
+      for (int k = 0; k < parts; ++k)
+        for (std::int32_t isl = g.part_island[static_cast<size_t>(k)]; isl < g.part_island[static_cast<size_t>(k) + 1]; ++isl)
+          island_part[static_cast<size_t>(isl)] = k;
+    } else {
+      g.part_island.clear();
+    }
+  }
+
+  // 4. Sort by part, then level (joints before contacts within a level,
+  // then creation order: `items` is in that order already, so a stable
+  // counting sort). An island's constraints keep their order whatever the
+  // parts: its levels come one after another in its own part.
   const auto itemLevel = [&](const Item& it) {
     const std::int32_t la = isDyn(it.a) ? level[static_cast<size_t>(it.a)] : 0;
     const std::int32_t lb = isDyn(it.b) ? level[static_cast<size_t>(it.b)] : 0;
@@ -278,20 +323,27 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   std::vector<std::int32_t>& level_start = ctx.level_start;
   std::int32_t max_level = 0;
   for (const Item& it : items) max_level = std::max(max_level, itemLevel(it));
-  level_start.assign(static_cast<size_t>(max_level) + 2, 0);
-  for (const Item& it : items) ++level_start[static_cast<size_t>(itemLevel(it)) + 1];
+  const std::int32_t levels = max_level + 1;  // per part
+  const auto itemKey = [&](const Item& it) {
+    return (parts > 1 ? island_part[static_cast<size_t>(it.island)] * levels : 0) + itemLevel(it);
+  };
+  level_start.assign(static_cast<size_t>(parts * levels) + 1, 0);
+  for (const Item& it : items) ++level_start[static_cast<size_t>(itemKey(it)) + 1];
   for (size_t k = 1; k < level_start.size(); ++k) level_start[k] += level_start[k - 1];
   sorted.resize(items.size());
-  for (const Item& it : items) sorted[static_cast<size_t>(level_start[static_cast<size_t>(itemLevel(it))]++)] = it;
+  for (const Item& it : items) sorted[static_cast<size_t>(level_start[static_cast<size_t>(itemKey(it))]++)] = it;
 
-  // 4. Colours: level by level, each level's constraints coloured greedily
+  // 5. Colours: level by level, each level's constraints coloured greedily
   // (the lowest of the level's colours in which neither dynamic body has a
-  // constraint yet), the levels' colours one after another.
+  // constraint yet), the levels' colours one after another; a part's
+  // colours after those of the part before.
   std::vector<std::uint64_t>& used = ctx.colour_used;
   used.assign(static_cast<size_t>(dyn), 0);
   ctx.colour_of.resize(sorted.size());
   std::int32_t colours = 0;
+  if (parts > 1) g.part_colour.assign(static_cast<size_t>(parts) + 1, 0);
   for (size_t lv = 0; lv + 1 < level_start.size(); ++lv) {
+    if (parts > 1 && lv % static_cast<size_t>(levels) == 0) g.part_colour[lv / static_cast<size_t>(levels)] = colours;
     const std::int32_t first = lv == 0 ? 0 : level_start[lv - 1];
     const std::int32_t last = level_start[lv];
     std::int32_t level_colours = 0;
@@ -317,8 +369,9 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
     }
     colours += level_colours;
   }
+  if (parts > 1) g.part_colour[static_cast<size_t>(parts)] = colours;
 
-  // 5. Layout: per colour its row groups, then its manifolds in batches of 8.
+  // 6. Layout: per colour its row groups, then its manifolds in batches of 8.
   std::vector<std::int32_t>&groups_in = ctx.groups_in, &manifolds_in = ctx.manifolds_in;
   groups_in.assign(static_cast<size_t>(colours), 0);
   manifolds_in.assign(static_cast<size_t>(colours), 0);
@@ -340,7 +393,7 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   ctx.group_joint.assign(static_cast<size_t>(group_at), 0);
   ctx.lane_contact.assign(static_cast<size_t>(batch_at) * kBatchLanes, -1);
 
-  // 6. Fill.
+  // 7. Fill.
   const Correction correction = s.split_impulse ? Correction::PseudoVelocity : s.position_correction;
   ContactFillParams fp;
   fp.h = h;
@@ -458,7 +511,7 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
       for (int i = 0; i < batch.count[lane]; ++i)
         if (batch.p[i].bias[lane] > 0) ctx.island_pushing[static_cast<size_t>(batch.island[lane])] = 1;
 
-  // 7. The other islands: generic rows island by island, joints first, then
+  // 8. The other islands: generic rows island by island, joints first, then
   // all contact normal rows before any friction row (ODE's and Bullet's
   // order). The direct and exact solvers solve the ERP target with the rest
   // in one exact solve, so joints keep it in rhs.

@@ -128,6 +128,7 @@ struct StepContext {
   // Scratch of the colouring.
   std::vector<GraphItem> items, sorted_items;
   std::vector<std::int32_t> colour_of, adj_start, adj, level, queue, level_start;
+  std::vector<std::int32_t> island_part, island_work;  // per island: its part of the graph, its constraints
   std::vector<std::int32_t> groups_in, manifolds_in, group_fill, lane_fill;
   std::vector<std::uint64_t> colour_used;  // per dynamic body: the current level's colours it is in
 

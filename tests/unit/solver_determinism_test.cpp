@@ -106,7 +106,8 @@ TEST(Determinism, IslandsSweptAsOnePartPerThreadAreBitIdentical) {
 // fill, the impulse store and the watchers hand their loops to the pool
 // (world/parallel_thresholds.hpp). A pyramid of base 60 (1,830 boxes,
 // about 5,400 touching manifolds) is past all four from its first step,
-// which the test checks before it compares 10 steps on 1, 2 and 4 threads.
+// and is one island, whose colours (not parts) the threads split; the test
+// checks both before it compares 10 steps on 1, 2 and 4 threads.
 TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
   const SceneDesc s = scenarios::pyramid(60);
   {
@@ -120,6 +121,9 @@ TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
     ASSERT_GE(batches, detail::kParallelBatches);
     ASSERT_GE(batches * kBatchLanes, detail::kParallelLanes);
     ASSERT_GE(static_cast<int>(in.contacts().size()), detail::kParallelContacts);
+    // One island: no even split into parts, so its colours are what the
+    // threads share.
+    ASSERT_TRUE(in.stepContext().graph.part_colour.empty());
   }
   const auto one = run(s, 10, 1, Simd::Auto);
   expectIdentical(one, run(s, 10, 2, Simd::Auto));

@@ -5,7 +5,7 @@
 // measured as its comment says. The solve's colours have their own rule
 // (solver/graph_solver.cpp). Results never depend on them: the threads
 // split a loop's items and every reduction runs in storage order on one
-// thread (tests/unit/solver_determinism_test.cpp runs a scene past all
+// thread (tests/unit/solver_determinism_test.cpp runs scenes past all
 // five on 1, 2 and 4 threads).
 #pragma once
 

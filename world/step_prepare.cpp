@@ -283,19 +283,17 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
     const auto total = static_cast<std::int64_t>(items.size());
     g.part_island.assign(static_cast<size_t>(threads) + 1, ctx.island_count);
     g.part_island[0] = 0;
-    std::int64_t done = 0;
+    std::int64_t done = 0, part_start = 0, largest = 0;  // constraints so far, at the part's start, in the largest part
     int next = 1;
     for (std::int32_t isl = 0; isl < ctx.island_count; ++isl) {
       done += work[static_cast<size_t>(isl)];
-      while (next < threads && done * threads >= total * next) g.part_island[static_cast<size_t>(next++)] = isl + 1;
+      while (next < threads && done * threads >= total * next) {
+        g.part_island[static_cast<size_t>(next++)] = isl + 1;
+        largest = std::max(largest, done - part_start);
+        part_start = done;
+      }
     }
-    std::int64_t largest = 0;
-    for (int k = 0; k < threads; ++k) {
-      std::int64_t in = 0;
-      for (std::int32_t isl = g.part_island[static_cast<size_t>(k)]; isl < g.part_island[static_cast<size_t>(k) + 1]; ++isl)
-        in += work[static_cast<size_t>(isl)];
-      largest = std::max(largest, in);
-    }
+    largest = std::max(largest, total - part_start);
     // At most a fifth over an even share: else the longest part would
     // keep the other threads waiting longer than the barriers cost.
     if (largest * threads * 5 <= total * 6) {

@@ -2,6 +2,7 @@
 
 #include "solver/dense_system.hpp"
 #include "solver/lcp_residual.hpp"
+#include "solver/tree_factor.hpp"
 
 #include <Eigen/CholmodSupport>
 
@@ -57,8 +58,9 @@ class CholmodFactor : public Eigen::CholmodDecomposition<SpMat, Eigen::Lower> {
 
 struct DirectSolver::Impl {
   CholmodFactor factor;
+  TreeFactor tree;  // used instead of CHOLMOD while the bilateral rows' bodies form a forest
   bool analysed = false;
-  std::vector<std::int32_t> key;  // coupling bodies of the bilateral rows, in order
+  std::vector<std::int32_t> key, next_key;  // coupling bodies of the bilateral rows, in order
   std::uint64_t hash = 0;
   int analysis_count = 0;
   // Scratch kept between calls so a steady scene does not allocate.
@@ -117,42 +119,53 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
   st.bilateral_rows = static_cast<int>(s.bilateral.size());
   st.unilateral_rows = static_cast<int>(s.unilateral.size());
 
-  // Factor A_BB, reusing the symbolic analysis when the pattern is unchanged.
+  // Factor A_BB, reusing the analysis while the pattern is unchanged: the
+  // tree factor when the rows' bodies form a forest (solver/tree_factor.hpp),
+  // else CHOLMOD.
   bool have_factor = false;
   if (!s.bilateral.empty()) {
-    // One triangle, as the factor reads it (Eigen::Lower), into reused arrays.
-    assembleSparseLower(rows, s.bilateral, CfmOnDiagonal::Include, s.assembly, s.abb);
-    const SpMat& abb = s.abb;
-    std::vector<std::int32_t> key;
-    key.reserve(2 * s.bilateral.size());
+    std::vector<std::int32_t>& key = s.next_key;
+    key.clear();
     for (int i : s.bilateral) {
       key.push_back(couplingBodyA(rows[static_cast<std::size_t>(i)]));
       key.push_back(couplingBodyB(rows[static_cast<std::size_t>(i)]));
     }
-    const std::uint64_t hash = hashKey(key);
-    if (!s.analysed || hash != s.hash || key != s.key) {
-      s.factor.analyzePattern(abb);
+    const bool analyse = !s.analysed || key != s.key;
+    if (analyse) {
       s.analysed = true;
-      s.key = std::move(key);
-      s.hash = hash;
+      std::swap(s.key, key);
+      s.hash = hashKey(s.key);
       ++s.analysis_count;
       st.analysed = true;
+      s.tree.analyse(rows, s.bilateral);
     }
     st.structure_hash = s.hash;
-
-    s.factor.setShift(0);
-    s.factor.factorize(abb);
-    ++st.factorizations;
-    have_factor = s.factor.info() == Eigen::Success && s.factor.pivotRatio() > kSingularPivotRatio;
+    st.tree_factor = s.tree.usable();
+    if (s.tree.usable()) {
+      ++st.factorizations;
+      have_factor = s.tree.factorize(rows, s.bilateral, 0) && s.tree.pivotRatio() > kSingularPivotRatio;
+    } else {
+      // One triangle, as the factor reads it (Eigen::Lower), into reused arrays.
+      assembleSparseLower(rows, s.bilateral, CfmOnDiagonal::Include, s.assembly, s.abb);
+      if (analyse) s.factor.analyzePattern(s.abb);
+      s.factor.setShift(0);
+      s.factor.factorize(s.abb);
+      ++st.factorizations;
+      have_factor = s.factor.info() == Eigen::Success && s.factor.pivotRatio() > kSingularPivotRatio;
+    }
     if (!have_factor) {
       Real max_diag = 0;
       for (int i : s.bilateral) max_diag = std::max(max_diag, s.diag[static_cast<std::size_t>(i)]);
       st.regularized = true;
       st.regularization = opt.regularization * (max_diag > 0 ? max_diag : Real(1));
-      s.factor.setShift(st.regularization);
-      s.factor.factorize(abb);
       ++st.factorizations;
-      have_factor = s.factor.info() == Eigen::Success && s.factor.pivotRatio() > 0;
+      if (s.tree.usable()) {
+        have_factor = s.tree.factorize(rows, s.bilateral, st.regularization) && s.tree.pivotRatio() > 0;
+      } else {
+        s.factor.setShift(st.regularization);
+        s.factor.factorize(s.abb);
+        have_factor = s.factor.info() == Eigen::Success && s.factor.pivotRatio() > 0;
+      }
       st.factorization_failed = !have_factor;
     }
   }
@@ -166,8 +179,15 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
       const ConstraintRow& r = rows[static_cast<std::size_t>(s.bilateral[static_cast<std::size_t>(p)])];
       s.rhs(p) = -(rowJv(r, bodies) - r.rhs + r.cfm * r.lambda);
     }
-    s.delta = s.factor.solve(s.rhs);
-    if (s.factor.info() != Eigen::Success || !s.delta.allFinite()) {
+    bool solved = true;
+    if (s.tree.usable()) {
+      s.delta = s.rhs;
+      s.tree.solveInPlace(std::span<double>(s.delta.data(), static_cast<std::size_t>(nb)));
+    } else {
+      s.delta = s.factor.solve(s.rhs);
+      solved = s.factor.info() == Eigen::Success;
+    }
+    if (!solved || !s.delta.allFinite()) {
       st.factorization_failed = true;
       have_factor = false;
       return;

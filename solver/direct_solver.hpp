@@ -16,12 +16,16 @@
 // hold exactly for the final unilateral impulses.
 //
 // w is always computed from the velocities (v = v* + M^-1 J^T lambda), so
-// step 1 needs only A_BB, never the coupling A_BU. A_BB is assembled
-// sparsely (solver/dense_system.hpp) and factored with CHOLMOD; the
-// symbolic analysis (fill-reducing ordering, elimination tree, supernodes)
-// depends only on which bilateral rows share which bodies, so it is kept
-// and reused while that pattern (hashed, then compared exactly) is
-// unchanged; only the numeric factorization runs each call.
+// step 1 needs only A_BB, never the coupling A_BU. When the bilateral
+// rows' bodies form a forest (chains, ragdolls, any tree of joints), A_BB
+// is factored in linear time by solver/tree_factor.hpp with no fill;
+// otherwise (closed loops) it is assembled sparsely (solver/
+// dense_system.hpp) and factored with CHOLMOD. Either analysis (the tree's
+// elimination order; CHOLMOD's fill-reducing ordering, elimination tree and
+// supernodes) depends only on which bilateral rows share which bodies, so
+// it is kept and reused while that pattern (the rows' coupling bodies,
+// compared exactly) is unchanged; only the numeric factorization runs
+// each call.
 //
 // If A_BB is not numerically positive definite (redundant bilateral rows
 // with cfm = 0, e.g. a closed loop of joints), it is refactored with
@@ -61,7 +65,8 @@ struct DirectSolveStats {
   int unilateral_rows = 0;
   int inert_rows = 0;              // move no body and have cfm = 0: lambda left at clamp(0, lo, hi)
   int outer_iterations = 0;        // performed
-  bool analysed = false;           // this call ran CHOLMOD's symbolic analysis
+  bool analysed = false;           // this call analysed the structure (tree factor's ordering or CHOLMOD's)
+  bool tree_factor = false;        // A_BB was factored by the tree factor, not CHOLMOD
   int analysis_count = 0;          // symbolic analyses over the solver's life
   int factorizations = 0;          // numeric factorizations in this call (2 when regularized)
   bool regularized = false;        // A_BB was not positive definite; `regularization` was added
@@ -72,7 +77,7 @@ struct DirectSolveStats {
   std::vector<double> residual_history;  // the same after each outer iteration (before the final step 1)
 };
 
-// Holds CHOLMOD's symbolic analysis between calls (one per island or scene
+// Holds the structure's analysis (the tree factor's or CHOLMOD's) between calls (one per island or scene
 // that keeps its structure). Not copyable; movable.
 class DirectSolver {
  public:

@@ -59,6 +59,19 @@ bool stiffened(const StepContext& ctx, std::int32_t isl) {
 
 Mat3 stiffness(const Vec3& f, const Vec3& r) { return f.dot(r) * Mat3::Identity() - r * f.transpose(); }
 
+// Sylvester's criterion for semidefiniteness: every principal minor of the
+// symmetric s is >= 0 (the three diagonal entries, the three 2 x 2 minors
+// and the determinant), each to round-off relative to s's largest entry: a
+// stretched joint's K has an exact zero eigenvalue (along the link), which
+// round-off leaves at +-1e-16 of the others, and keeping a part that small
+// changes the augmented inertia by nothing it can show.
+bool positiveSemidefinite(const Mat3& s) {
+  const Real a = s(0, 0), d = s(1, 1), f = s(2, 2), b = s(0, 1), c = s(0, 2), e = s(1, 2);
+  const Real scale = s.cwiseAbs().maxCoeff(), tol = Real(1e-12) * scale;
+  return a >= -tol && d >= -tol && f >= -tol && a * d - b * b >= -tol * scale && a * f - c * c >= -tol * scale &&
+         d * f - e * e >= -tol * scale && s.determinant() >= -tol * scale * scale;
+}
+
 }  // namespace
 
 void stiffenRotations(WorldImpl& w, StepContext& ctx) {
@@ -84,13 +97,22 @@ void stiffenRotations(WorldImpl& w, StepContext& ctx) {
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
     const Mat3& k = ctx.stiffness[i];
     if (k.isZero(0)) continue;
-    Eigen::SelfAdjointEigenSolver<Mat3> es(Mat3(Real(0.5) * (k + k.transpose())));
-    const Vec3 positive = es.eigenvalues().cwiseMax(Real(0));
-    if (!(positive.maxCoeff() > 0)) continue;
+    const Mat3 sym = Real(0.5) * (k + k.transpose());
+    Mat3 kept;
+    if (positiveSemidefinite(sym)) {
+      // A stretched joint's K (the common case, a chain under tension):
+      // nothing to drop, so no eigendecomposition.
+      if (!(sym.trace() > 0)) continue;
+      kept = sym;
+    } else {
+      Eigen::SelfAdjointEigenSolver<Mat3> es(sym);
+      const Vec3 positive = es.eigenvalues().cwiseMax(Real(0));
+      if (!(positive.maxCoeff() > 0)) continue;
+      kept = es.eigenvectors() * positive.asDiagonal() * es.eigenvectors().transpose();
+    }
     Body& b = w.bodies_[i];
     const Mat3 inertia = b.rotation * b.inertia_body * b.rotation.transpose();
-    const Mat3 augmented = inertia + h2 * es.eigenvectors() * positive.asDiagonal() * es.eigenvectors().transpose();
-    b.inv_inertia_world = augmented.inverse();
+    b.inv_inertia_world = (inertia + h2 * kept).inverse();
   }
 }
 

@@ -240,7 +240,9 @@ void buildJointRows(const Joint& j, const BodyView& a, const BodyView& b, RowCon
 JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& b) {
   JointError e;
   const Vec3 pa = worldPoint(a, j.local_anchor_a), pb = worldPoint(b, j.local_anchor_b);
-  const Vec3 axa = worldVector(a, j.local_axis_a), axb = worldVector(b, j.local_axis_b);
+  // The axes only for the joints that read them (the watchers measure every
+  // joint every step).
+  const auto axisA = [&] { return worldVector(a, j.local_axis_a); };
   const auto beyond = [](const LimitDef& l, Real s) {
     if (!l.enabled) return Real(0);
     return std::max({l.lower - s, s - l.upper, Real(0)});
@@ -251,10 +253,11 @@ JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& 
       break;
     case JointType::Hinge:
       e.linear = (pb - pa).norm();
-      e.angular = std::max(std::asin(std::min(Real(1), axa.cross(axb).norm())), beyond(j.def.limit, angleNearLimits(hingeAngle(j, a, b), j.def.limit)));
+      e.angular = std::max(std::asin(std::min(Real(1), axisA().cross(worldVector(b, j.local_axis_b)).norm())),
+                           beyond(j.def.limit, angleNearLimits(hingeAngle(j, a, b), j.def.limit)));
       break;
     case JointType::Slider: {
-      const Vec3 d = pb - pa;
+      const Vec3 d = pb - pa, axa = axisA();
       e.linear = std::max((d - axa * axa.dot(d)).norm(), beyond(j.def.limit, sliderPosition(j, a, b)));
       e.angular = rotationVectorFromQuat(b.q * (a.q * j.rel_orientation0).conjugate()).norm();
       break;
@@ -265,7 +268,7 @@ JointError measureJointError(const Joint& j, const BodyView& a, const BodyView& 
       break;
     case JointType::Universal:
       e.linear = (pb - pa).norm();
-      e.angular = std::abs(std::asin(std::clamp(axa.dot(worldVector(b, j.local_axis2_b)), Real(-1), Real(1))));
+      e.angular = std::abs(std::asin(std::clamp(axisA().dot(worldVector(b, j.local_axis2_b)), Real(-1), Real(1))));
       break;
     case JointType::ConeTwist: {
       e.linear = (pb - pa).norm();

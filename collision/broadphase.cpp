@@ -27,6 +27,22 @@ void BroadPhase::markMoved(int h) {
   }
 }
 
+void BroadPhase::leaveTree(int h) {
+  Proxy& p = proxies_[h];
+  tree_.remove(p.leaf);
+  p.leaf = -1;
+  p.loner = true;
+  loners_.insert(std::lower_bound(loners_.begin(), loners_.end(), h), h);
+}
+
+void BroadPhase::enterTree(int h) {
+  Proxy& p = proxies_[h];
+  loners_.erase(std::lower_bound(loners_.begin(), loners_.end(), h));
+  p.loner = false;
+  p.leaf = tree_.insert(p.fat, h);
+  markMoved(h);  // to be queried for the pairs it may now have
+}
+
 int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacement, int owner) {
   int h;
   if (free_ >= 0) {
@@ -48,6 +64,7 @@ int BroadPhase::createProxy(const Aabb& tight, int user, const Vec3& displacemen
   addFilter(p.group, p.mask);
   if (tight.isInfinite()) {
     p.fat = tight;
+    p.infinite = true;
     infinite_.insert(std::lower_bound(infinite_.begin(), infinite_.end(), h), h);
   } else {
     p.fat = fatten(tight, displacement);
@@ -62,6 +79,7 @@ void BroadPhase::destroyProxy(int h) {
   Proxy& p = proxies_[h];
   if (!p.alive) return;
   if (p.leaf >= 0) tree_.remove(p.leaf);
+  else if (p.loner) loners_.erase(std::lower_bound(loners_.begin(), loners_.end(), h));
   else infinite_.erase(std::lower_bound(infinite_.begin(), infinite_.end(), h));
   if (!p.dirty) {
     p.dirty = true;
@@ -69,6 +87,7 @@ void BroadPhase::destroyProxy(int h) {
   }
   p.alive = false;
   p.leaf = -1;
+  p.loner = false;
   filters_stale_ = true;
   p.next_free = free_;
   free_ = h;
@@ -77,7 +96,7 @@ void BroadPhase::destroyProxy(int h) {
 
 bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
   Proxy& p = proxies_[h];
-  if (p.leaf < 0) {
+  if (p.infinite) {
     // An infinite proxy (a plane) keeps the box it is given: a moved plane's
     // half-space bounds something else.
     if (p.fat.lo == tight.lo && p.fat.hi == tight.hi) return false;
@@ -86,6 +105,12 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
     return true;
   }
   const Aabb want = fatten(tight, displacement);
+  if (!p.loner && !mayPairWithAny(p.group, p.mask)) leaveTree(h);
+  if (p.loner) {
+    // Out of the tree: its box is only read by queries, tested one by one.
+    p.fat = want;
+    return false;
+  }
   bool reinsert = !p.fat.contains(tight);
   if (!reinsert) {
     // A fat box far larger than wanted (the body slowed down) costs false
@@ -131,8 +156,12 @@ void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) 
     if (!p.alive) continue;
     ++live_;
     addFilter(p.group, p.mask);
-    if (p.fat.isInfinite()) infinite_.push_back(h);
-    else p.leaf = tree_.insert(p.fat, h);
+    if (p.fat.isInfinite()) {
+      p.infinite = true;
+      infinite_.push_back(h);
+    } else {
+      p.leaf = tree_.insert(p.fat, h);
+    }
     markMoved(h);
   }
   free_ = free_head;
@@ -145,6 +174,12 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
     for (const Proxy& p : proxies_)
       if (p.alive) addFilter(p.group, p.mask);
     filters_stale_ = false;
+  }
+  // Loners that a new or refiltered proxy gave something to pair with go
+  // back into the tree, to be queried below.
+  for (size_t k = loners_.size(); k-- > 0;) {
+    const int h = loners_[k];
+    if (mayPairWithAny(proxies_[h].group, proxies_[h].mask)) enterTree(h);
   }
   // 1. Pairs found by querying each moved proxy. A query stops at
   //    max_pairs_ other proxies (the bound in the header). A pair of two
@@ -164,15 +199,15 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
       if (o == m || (pm.owner >= 0 && po.owner == pm.owner)) return true;
       if ((pm.group & po.mask) == 0 || (po.group & pm.mask) == 0) return true;
       fresh_.emplace_back(std::min(m, o), std::max(m, o));
-      if (pm.leaf < 0 || po.leaf < 0 || ++found < max_pairs_) return true;
+      if (pm.infinite || po.infinite || ++found < max_pairs_) return true;
       capped_.push_back(m);
       return false;
     };
-    if (pm.leaf < 0) {
+    if (pm.infinite) {
       // Infinite: tested against every finite proxy (an axis-aligned
       // plane's box still rules out what lies wholly above it).
       for (int o = 0; o < static_cast<int>(proxies_.size()); ++o) {
-        if (!proxies_[o].alive || proxies_[o].leaf < 0) continue;
+        if (!proxies_[o].alive || proxies_[o].infinite) continue;
         ++overlap_tests_;
         if (pm.fat.overlaps(proxies_[o].fat)) add(o);
       }

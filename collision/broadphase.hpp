@@ -32,6 +32,16 @@
 // chain whose links never collide with each other makes no pairs to sort,
 // keep and hand to the narrowphase only to be thrown away there.
 //
+// Proxies that can pair with nothing (a chain's links whose filter meets
+// no live proxy's, mayPairWithAny) are kept out of the tree, in a sorted
+// list that queries and ray casts test one by one as they test infinite
+// proxies: such a proxy moves every step and, fast, leaves its fat box
+// most steps, and a tree reinsertion costs a descent and the refits above
+// it for a box that no pair search will ever ask about. A proxy enters
+// the list at its next move once it can pair with nothing, and goes back
+// into the tree (to be queried for pairs) at the updatePairs after a new
+// or refiltered proxy gives it something to pair with.
+//
 // Bounded pairs: one proxy's query stops after max_pairs_per_proxy other
 // proxies (setMaxPairsPerProxy), so the pair list holds at most that many
 // pairs per finite proxy whatever the scene (N coincident boxes make
@@ -117,7 +127,9 @@ class BroadPhase {
 
   int user(int handle) const { return proxies_[handle].user; }
   const Aabb& fatAabb(int handle) const { return proxies_[handle].fat; }
-  bool isInfinite(int handle) const { return proxies_[handle].leaf < 0; }
+  bool isInfinite(int handle) const { return proxies_[handle].infinite; }
+  // Live finite proxies kept out of the tree (they can pair with nothing).
+  const std::vector<int>& loners() const { return loners_; }
   int proxyCount() const { return live_; }
   const DynamicTree& tree() const { return tree_; }
 
@@ -133,9 +145,11 @@ class BroadPhase {
   void query(const Aabb& box, Visit&& visit, std::uint64_t* tests = nullptr) const {
     bool go = true;
     tree_.query(box, [&](int leaf) { return go = visit(tree_.user(leaf)); }, tests);
-    for (int h : infinite_)
-      if (go && proxies_[h].fat.overlaps(box) && !visit(h)) break;
-    if (tests) *tests += infinite_.size();
+    for (const std::vector<int>* list : {&infinite_, &loners_}) {
+      for (int h : *list)
+        if (go && proxies_[h].fat.overlaps(box)) go = visit(h);
+      if (tests) *tests += list->size();
+    }
   }
 
   // Calls visit(handle, max_fraction) for every proxy whose fat box, grown
@@ -147,13 +161,15 @@ class BroadPhase {
   void rayCast(const Vec3& origin, const Vec3& translation, Real max_fraction, const Vec3& extent, Visit&& visit,
                std::uint64_t* tests = nullptr) const {
     const Vec3 inv = translation.cwiseInverse();
-    if (tests) *tests += infinite_.size();
-    for (int h : infinite_) {
-      Real t0 = 0, t1 = max_fraction;
-      if (!clipLineToBox(proxies_[h].fat.lo - extent, proxies_[h].fat.hi + extent, origin, inv, t0, t1)) continue;
-      const Real f = visit(h, max_fraction);
-      if (f < 0) return;
-      max_fraction = std::min(max_fraction, f);
+    for (const std::vector<int>* list : {&infinite_, &loners_}) {
+      if (tests) *tests += list->size();
+      for (int h : *list) {
+        Real t0 = 0, t1 = max_fraction;
+        if (!clipLineToBox(proxies_[h].fat.lo - extent, proxies_[h].fat.hi + extent, origin, inv, t0, t1)) continue;
+        const Real f = visit(h, max_fraction);
+        if (f < 0) return;
+        max_fraction = std::min(max_fraction, f);
+      }
     }
     tree_.rayCast(origin, translation, max_fraction, extent,
                   [&](int leaf, Real max_f) { return visit(tree_.user(leaf), max_f); }, tests);
@@ -164,7 +180,9 @@ class BroadPhase {
     Aabb fat;
     int user = -1;
     int owner = -1;
-    int leaf = -1;       // tree node; -1 when infinite or free
+    int leaf = -1;       // tree node; -1 when infinite, a loner or free
+    bool infinite = false;
+    bool loner = false;  // finite but kept out of the tree (loners_)
     int next_free = -1;
     bool alive = false;
     bool moved = false;  // fat box changed since the last updatePairs
@@ -174,6 +192,8 @@ class BroadPhase {
 
   Aabb fatten(const Aabb& tight, const Vec3& displacement) const;
   void markMoved(int handle);
+  void leaveTree(int handle);
+  void enterTree(int handle);
   void addFilter(std::uint32_t group, std::uint32_t mask) {
     group_union_ |= group;
     mask_union_ |= mask;
@@ -184,6 +204,7 @@ class BroadPhase {
   DynamicTree tree_;  // leaves' user field holds the proxy handle
   std::vector<Proxy> proxies_;
   std::vector<int> infinite_;  // handles of infinite proxies, ascending
+  std::vector<int> loners_;    // handles of finite proxies out of the tree, ascending
   std::vector<int> moved_;     // handles to re-query, in order of marking
   std::vector<int> dirty_;     // handles whose old pairs are stale
   std::vector<std::pair<int, int>> pairs_;

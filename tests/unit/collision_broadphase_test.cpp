@@ -204,5 +204,53 @@ TEST(BroadPhasePairs, ProxyThatCanPairWithNothingIsNotQueried) {
                        {links[8], links[10]}, {links[9], links[10]}, {links[10], links[11]}, {links[10], links[12]}}));
 }
 
+// Links that can pair with nothing leave the tree at their next move (no
+// reinsertion however far they go), yet box queries and ray casts still
+// find them; a proxy that gives them something to pair with brings them
+// back into the tree and into the pairs.
+TEST(BroadPhasePairs, ProxiesThatCanPairWithNothingLeaveTheTreeAndQueriesStillFindThem) {
+  BroadPhase bp(0.1);
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<int> links;
+  for (int i = 0; i < 20; ++i) {
+    links.push_back(bp.createProxy(Aabb::fromCenterHalf(Vec3(0.5 * i, 0, 0), Vec3::Constant(0.4)), i));
+    bp.setFilter(links.back(), 2, ~2u);
+  }
+  bp.updatePairs(pairs);
+  // Each link moves far (a whipping chain): out of the tree, into the list.
+  for (int i = 0; i < 20; ++i)
+    bp.moveProxy(links[static_cast<size_t>(i)], Aabb::fromCenterHalf(Vec3(0.5 * i, 3, 0), Vec3::Constant(0.4)));
+  EXPECT_EQ(bp.tree().leafCount(), 0);
+  EXPECT_EQ(bp.loners().size(), 20u);
+  ASSERT_TRUE(bp.tree().validate());
+  // A box query over x in [1.9, 3.1] meets links 3 to 7 (fat half 0.5).
+  std::vector<int> hit;
+  bp.query(Aabb::fromCenterHalf(Vec3(2.5, 3, 0), Vec3(0.6, 0.1, 0.1)), [&](int h) {
+    hit.push_back(h);
+    return true;
+  });
+  std::sort(hit.begin(), hit.end());
+  EXPECT_EQ(hit, (std::vector<int>{links[3], links[4], links[5], links[6], links[7]}));
+  // A ray along the row meets every link's box; one below it meets none.
+  int along = 0, below = 0;
+  bp.rayCast(Vec3(-1, 3, 0), Vec3(20, 0, 0), 1, Vec3::Zero(), [&](int, Real f) {
+    ++along;
+    return f;
+  });
+  bp.rayCast(Vec3(-1, 0, 0), Vec3(20, 0, 0), 1, Vec3::Zero(), [&](int, Real f) {
+    ++below;
+    return f;
+  });
+  EXPECT_EQ(along, 20);
+  EXPECT_EQ(below, 0);
+  // A ball of group 1 that takes everything: the links come back and pair.
+  const int ball = bp.createProxy(Aabb::fromCenterHalf(Vec3(0, 3.5, 0), Vec3::Constant(0.3)), 99);
+  bp.updatePairs(pairs);
+  EXPECT_TRUE(bp.loners().empty());
+  EXPECT_EQ(bp.tree().leafCount(), 21);
+  EXPECT_EQ(pairs, (std::vector<std::pair<int, int>>{{links[0], ball}, {links[1], ball}}));
+  ASSERT_TRUE(bp.tree().validate());
+}
+
 }  // namespace
 }  // namespace cairn

@@ -189,6 +189,7 @@ bool TreeFactor::analyse(std::span<const ConstraintRow> rows, std::span<const in
     if (update_.size() > kUpdatesPerGroup * static_cast<std::size_t>(groups) + 64) return false;
   }
   work_.assign(static_cast<std::size_t>(n), 0.0);
+  recip_.assign(static_cast<std::size_t>(n), 0.0);
   usable_ = true;
   return true;
 }
@@ -206,16 +207,24 @@ template <int M, bool kWithMass>
 void gatherSlot(std::span<const ConstraintRow> rows, std::span<const int> subset, const std::int32_t* pos, int m,
                 std::int32_t body, double* j, double* mj) {
   const int size = M > 0 ? M : m;
+  const auto put = [](double* out, const Vec3& lin, const Vec3& ang) {
+    for (int c = 0; c < 3; ++c) {
+      out[c] = lin[c];
+      out[3 + c] = ang[c];
+    }
+  };
   for (int i = 0; i < size; ++i) {
     const ConstraintRow& r = rows[static_cast<std::size_t>(subset[static_cast<std::size_t>(pos[i])])];
-    const double fa = r.body_a == body ? 1.0 : 0.0, fb = r.body_b == body ? 1.0 : 0.0;
-    for (int c = 0; c < 3; ++c) {
-      j[6 * i + c] = fa * r.j_lin_a[c] + fb * r.j_lin_b[c];
-      j[6 * i + 3 + c] = fa * r.j_ang_a[c] + fb * r.j_ang_b[c];
-      if constexpr (kWithMass) {
-        mj[6 * i + c] = fa * r.m_lin_a[c] + fb * r.m_lin_b[c];
-        mj[6 * i + 3 + c] = fa * r.m_ang_a[c] + fb * r.m_ang_b[c];
-      }
+    const bool a = r.body_a == body, b = r.body_b == body;
+    if (a && b) {  // both sides on the body: their sum
+      put(j + 6 * i, r.j_lin_a + r.j_lin_b, r.j_ang_a + r.j_ang_b);
+      if constexpr (kWithMass) put(mj + 6 * i, r.m_lin_a + r.m_lin_b, r.m_ang_a + r.m_ang_b);
+    } else if (a) {
+      put(j + 6 * i, r.j_lin_a, r.j_ang_a);
+      if constexpr (kWithMass) put(mj + 6 * i, r.m_lin_a, r.m_ang_a);
+    } else {
+      put(j + 6 * i, r.j_lin_b, r.j_ang_b);
+      if constexpr (kWithMass) put(mj + 6 * i, r.m_lin_b, r.m_ang_b);
     }
   }
 }
@@ -239,6 +248,7 @@ bool TreeFactor::eliminate(const Group& g, std::span<const ConstraintRow> rows, 
       gatherSlot<M, true>(rows, subset, pg, m, g.body[t], base + t * 12 * m, base + t * 12 * m + 6 * m);
 
   double* l = values_.data() + g.diag;
+  double* inv = recip_.data() + g.rows;  // 1 / L_jj: the triangular solves multiply
   for (int i = 0; i < m; ++i) {
     for (int j = 0; j <= i; ++j) {
       double v = 0;
@@ -254,12 +264,13 @@ bool TreeFactor::eliminate(const Group& g, std::span<const ConstraintRow> rows, 
     if (!(d > 0) || !std::isfinite(d)) return false;
     const double root = std::sqrt(d);
     l[j * m + j] = root;
+    inv[j] = 1 / root;
     lo = std::min(lo, root);
     hi = std::max(hi, root);
     for (int i = j + 1; i < m; ++i) {
       double v = l[i * m + j];
       for (int k = 0; k < j; ++k) v -= l[i * m + k] * l[j * m + k];
-      l[i * m + j] = v / root;
+      l[i * m + j] = v * inv[j];
     }
   }
 
@@ -276,7 +287,7 @@ bool TreeFactor::eliminate(const Group& g, std::span<const ConstraintRow> rows, 
       for (int j = 0; j < m; ++j) {
         double v = b[r * m + j] + dot6(jk + 6 * r, mg + 6 * j);
         for (int c = 0; c < j; ++c) v -= b[r * m + c] * l[j * m + c];
-        b[r * m + j] = v / l[j * m + j];
+        b[r * m + j] = v * inv[j];
       }
   }
   for (std::int32_t u = g.update_begin; u < g.update_end; ++u) {
@@ -325,11 +336,12 @@ void TreeFactor::solveInPlace(std::span<double> x) const {
   for (const Group& g : groups_) {
     const std::int32_t m = g.size;
     const double* l = values_.data() + g.diag;
+    const double* inv = recip_.data() + g.rows;
     double* y = w + g.rows;
     for (std::int32_t j = 0; j < m; ++j) {
       double v = y[j];
       for (std::int32_t k = 0; k < j; ++k) v -= l[j * m + k] * y[k];
-      y[j] = v / l[j * m + j];
+      y[j] = v * inv[j];
     }
     for (std::int32_t s = g.next_begin; s < g.next_end; ++s) {
       const Group& k = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(s)])];
@@ -347,6 +359,7 @@ void TreeFactor::solveInPlace(std::span<double> x) const {
     const Group& g = *it;
     const std::int32_t m = g.size;
     const double* l = values_.data() + g.diag;
+    const double* inv = recip_.data() + g.rows;
     double* y = w + g.rows;
     for (std::int32_t s = g.next_begin; s < g.next_end; ++s) {
       const Group& k = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(s)])];
@@ -361,7 +374,7 @@ void TreeFactor::solveInPlace(std::span<double> x) const {
     for (std::int32_t j = m - 1; j >= 0; --j) {
       double v = y[j];
       for (std::int32_t k = j + 1; k < m; ++k) v -= l[k * m + j] * y[k];
-      y[j] = v / l[j * m + j];
+      y[j] = v * inv[j];
     }
   }
   for (std::size_t k = 0; k < pos_.size(); ++k) x[static_cast<std::size_t>(pos_[k])] = w[k];

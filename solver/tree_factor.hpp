@@ -90,6 +90,7 @@ class TreeFactor {
   std::vector<Shared> shared_;         // per next_ entry
   std::vector<Update> update_;
   std::vector<double> values_;
+  std::vector<double> recip_;          // 1 / L's diagonal entries, in group order
   double pivot_ratio_ = 0;
   // Scratch: the solve's right-hand side in group order (solveInPlace).
   mutable std::vector<double> work_;

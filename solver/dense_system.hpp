@@ -53,6 +53,17 @@ inline std::int32_t couplingBodyB(const ConstraintRow& r) {
 // A_ij (without cfm) from two rows.
 Real rowCoupling(const ConstraintRow& ri, const ConstraintRow& rj);
 
+// A_ii (without cfm) given the row's coupling bodies ca = couplingBodyA(r)
+// and cb = couplingBodyB(r): rowCoupling(r, r), summed in the same order.
+inline Real rowSelfCoupling(const ConstraintRow& r, std::int32_t ca, std::int32_t cb) {
+  const Real aa = ca != 0 ? r.j_lin_a.dot(r.m_lin_a) + r.j_ang_a.dot(r.m_ang_a) : Real(0);
+  const Real bb = cb != 0 ? r.j_lin_b.dot(r.m_lin_b) + r.j_ang_b.dot(r.m_ang_b) : Real(0);
+  if (ca == 0 || ca != cb) return aa + bb;
+  const Real ab = r.j_lin_a.dot(r.m_lin_b) + r.j_ang_a.dot(r.m_ang_b);
+  const Real ba = r.j_lin_b.dot(r.m_lin_a) + r.j_ang_b.dot(r.m_ang_a);
+  return aa + ab + ba + bb;
+}
+
 // J_i v: the row's current relative velocity. Every side enters, including
 // the world and kinematic bodies (whose velocity is what it is).
 inline Real rowJv(const ConstraintRow& r, std::span<const SolverBody> bodies) {

@@ -66,6 +66,7 @@ struct DirectSolver::Impl {
   // Scratch kept between calls so a steady scene does not allocate.
   std::vector<int> bilateral, unilateral;
   std::vector<Real> diag;
+  std::vector<std::int32_t> coupling;  // per row: its coupling bodies (a, b), 0 for none
   Eigen::VectorXd rhs, delta;
   SparseAssembly assembly;
   SpMat abb;
@@ -103,9 +104,13 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
   s.bilateral.clear();
   s.unilateral.clear();
   s.diag.assign(n, 0);
+  s.coupling.resize(2 * n);
   for (std::size_t i = 0; i < n; ++i) {
     ConstraintRow& r = rows[i];
-    s.diag[i] = rowCoupling(r, r) + r.cfm;
+    const std::int32_t ca = couplingBodyA(r), cb = couplingBodyB(r);
+    s.coupling[2 * i] = ca;
+    s.coupling[2 * i + 1] = cb;
+    s.diag[i] = rowSelfCoupling(r, ca, cb) + r.cfm;
     if (!(s.diag[i] > 0)) {
       // Inert: moves no body and has no cfm, so no lambda changes its w.
       const Real pinned = r.normal_row >= 0 ? Real(0) : std::clamp(Real(0), r.lo, std::max(r.lo, r.hi));
@@ -127,8 +132,8 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
     std::vector<std::int32_t>& key = s.next_key;
     key.clear();
     for (int i : s.bilateral) {
-      key.push_back(couplingBodyA(rows[static_cast<std::size_t>(i)]));
-      key.push_back(couplingBodyB(rows[static_cast<std::size_t>(i)]));
+      key.push_back(s.coupling[2 * static_cast<std::size_t>(i)]);
+      key.push_back(s.coupling[2 * static_cast<std::size_t>(i) + 1]);
     }
     const bool analyse = !s.analysed || key != s.key;
     if (analyse) {

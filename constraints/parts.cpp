@@ -78,7 +78,8 @@ Real angleNearLimits(Real s, const LimitDef& l) {
 
 int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, const Vec3& lin_a, const Vec3& ang_a,
            const Vec3& lin_b, const Vec3& ang_b, Real c, const Softness* axis_softness, Real lo, Real hi) {
-  ConstraintRow r;
+  // Built where it will stay (the rows are ~300 bytes: no copy into the list).
+  ConstraintRow& r = ctx.rows->emplace_back();
   r.body_a = a.solver_index;
   r.body_b = b.solver_index;
   r.j_lin_a = lin_a;
@@ -90,7 +91,10 @@ int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, cons
   r.m_lin_b = b.inv_mass * b.lin_factor.cwiseProduct(lin_b);
   r.m_ang_b = b.inv_inertia * ang_b;
   const Real diag = lin_a.dot(r.m_lin_a) + ang_a.dot(r.m_ang_a) + lin_b.dot(r.m_lin_b) + ang_b.dot(r.m_ang_b);
-  if (!(diag > Real(1e-300))) return -1;  // neither body can move along this row
+  if (!(diag > Real(1e-300))) {  // neither body can move along this row
+    ctx.rows->pop_back();
+    return -1;
+  }
   const ErpCfm soft = resolveSoftness(axis_softness, *ctx.joint_softness, ctx.erp, ctx.cfm, 1 / diag, ctx.h);
   r.cfm = soft.cfm / ctx.h;  // ODE's CFM multiplies a force; lambda is an impulse
   r.inv_diag = 1 / (diag + r.cfm);
@@ -110,7 +114,6 @@ int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, cons
   if (ctx.warm && slot < static_cast<int>(ctx.warm->size())) {
     r.lambda = std::clamp(ctx.warm_factor * (*ctx.warm)[slot], lo, hi);
   }
-  ctx.rows->push_back(r);
   return static_cast<int>(ctx.rows->size() - 1);
 }
 

@@ -111,7 +111,8 @@ void stiffenRotations(WorldImpl& w, StepContext& ctx) {
       kept = es.eigenvectors() * positive.asDiagonal() * es.eigenvectors().transpose();
     }
     Body& b = w.bodies_[i];
-    const Mat3 inertia = b.rotation * b.inertia_body * b.rotation.transpose();
+    // R (c 1) R^T = c 1: a sphere's or a cube's world inertia is its own.
+    const Mat3 inertia = isIsotropic(b.inertia_body) ? b.inertia_body : Mat3(b.rotation * b.inertia_body * b.rotation.transpose());
     b.inv_inertia_world = (inertia + h2 * kept).inverse();
   }
 }

@@ -8,18 +8,20 @@
 namespace cairn::detail {
 
 BodyView WorldImpl::view(int index) const {
-  BodyView v;
   const Body& b = bodies_[static_cast<size_t>(index)];
-  v.solver_index = index + 1;  // the step replaces it with the body's solver index
-  v.x = b.position;
-  v.q = b.orientation;
-  v.rot = b.rotation;
-  v.inv_mass = b.isDynamic() ? b.inv_mass : Real(0);
-  v.lin_factor = b.linear_factor;
-  v.inv_inertia = b.isDynamic() ? b.inv_inertia_world : Mat3::Zero();
-  v.v = b.linear_velocity;
-  v.w = b.angular_velocity;
-  return v;
+  const bool dynamic = b.isDynamic();
+  // Every member written once (a default-constructed view would first be
+  // filled with identities and zeros; the step makes a view per joint side
+  // several times a step).
+  return BodyView{.solver_index = index + 1,  // the step replaces it with the body's solver index
+                  .x = b.position,
+                  .q = b.orientation,
+                  .rot = b.rotation,
+                  .inv_mass = dynamic ? b.inv_mass : Real(0),
+                  .lin_factor = b.linear_factor,
+                  .inv_inertia = dynamic ? b.inv_inertia_world : Mat3(Mat3::Zero()),
+                  .v = b.linear_velocity,
+                  .w = b.angular_velocity};
 }
 
 BodyView WorldImpl::view(BodyId id) const { return id.isWorld() ? BodyView{} : view(id.index); }

@@ -249,6 +249,7 @@ void storeImpulses(WorldImpl& w, StepContext& ctx) {
   for (size_t i = 0; i < w.joints_.size(); ++i) {
     Joint& j = w.joints_[i];
     if (!j.alive || j.broken) continue;
+    if (j.def.break_force == kInf && j.def.break_torque == kInf) continue;  // unbreakable (the default)
     const Real force = j.feedback.force_b.norm();
     // Torque about the anchor on b: remove the moment of the force about b's center.
     const BodyView bv = w.view(j.def.body_b);

@@ -60,6 +60,7 @@ struct DirectSolver::Impl {
   CholmodFactor factor;
   TreeFactor tree;  // used instead of CHOLMOD while the bilateral rows' bodies form a forest
   bool analysed = false;
+  bool cholmod_analysed = false;  // CHOLMOD's symbolic analysis is of the current pattern
   std::vector<std::int32_t> key, next_key;  // coupling bodies of the bilateral rows, in order
   std::uint64_t hash = 0;
   int analysis_count = 0;
@@ -125,9 +126,14 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
   st.unilateral_rows = static_cast<int>(s.unilateral.size());
 
   // Factor A_BB, reusing the analysis while the pattern is unchanged: the
-  // tree factor when the rows' bodies form a forest (solver/tree_factor.hpp),
-  // else CHOLMOD.
+  // tree factor when the rows' bodies form a forest (solver/tree_factor.hpp)
+  // and A_BB is positive definite, else CHOLMOD. A singular A_BB (redundant
+  // or conflicting rows) is regularised by CHOLMOD whatever the structure:
+  // its shifted solve splits a dependent pair's impulse into huge opposite
+  // halves whose round-off reaches the velocities, and the extremes suite's
+  // redundant and conflicting joints are measured on that solve.
   bool have_factor = false;
+  bool use_tree = false;
   if (!s.bilateral.empty()) {
     std::vector<std::int32_t>& key = s.next_key;
     key.clear();
@@ -135,9 +141,9 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
       key.push_back(s.coupling[2 * static_cast<std::size_t>(i)]);
       key.push_back(s.coupling[2 * static_cast<std::size_t>(i) + 1]);
     }
-    const bool analyse = !s.analysed || key != s.key;
-    if (analyse) {
+    if (!s.analysed || key != s.key) {
       s.analysed = true;
+      s.cholmod_analysed = false;
       std::swap(s.key, key);
       s.hash = hashKey(s.key);
       ++s.analysis_count;
@@ -145,34 +151,35 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
       s.tree.analyse(rows, s.bilateral);
     }
     st.structure_hash = s.hash;
-    st.tree_factor = s.tree.usable();
-    if (s.tree.usable()) {
-      ++st.factorizations;
-      have_factor = s.tree.factorize(rows, s.bilateral, 0) && s.tree.pivotRatio() > kSingularPivotRatio;
-    } else {
-      // One triangle, as the factor reads it (Eigen::Lower), into reused arrays.
+    // CHOLMOD on one triangle, as the factor reads it (Eigen::Lower),
+    // assembled into reused arrays; its symbolic analysis once per pattern.
+    const auto cholmod = [&](double shift) {
       assembleSparseLower(rows, s.bilateral, CfmOnDiagonal::Include, s.assembly, s.abb);
-      if (analyse) s.factor.analyzePattern(s.abb);
-      s.factor.setShift(0);
+      if (!s.cholmod_analysed) {
+        s.factor.analyzePattern(s.abb);
+        s.cholmod_analysed = true;
+      }
+      s.factor.setShift(shift);
       s.factor.factorize(s.abb);
       ++st.factorizations;
-      have_factor = s.factor.info() == Eigen::Success && s.factor.pivotRatio() > kSingularPivotRatio;
+      return s.factor.info() == Eigen::Success;
+    };
+    if (s.tree.usable()) {
+      ++st.factorizations;
+      use_tree = s.tree.factorize(rows, s.bilateral, 0) && s.tree.pivotRatio() > kSingularPivotRatio;
+      have_factor = use_tree;
+    } else {
+      have_factor = cholmod(0) && s.factor.pivotRatio() > kSingularPivotRatio;
     }
     if (!have_factor) {
       Real max_diag = 0;
       for (int i : s.bilateral) max_diag = std::max(max_diag, s.diag[static_cast<std::size_t>(i)]);
       st.regularized = true;
       st.regularization = opt.regularization * (max_diag > 0 ? max_diag : Real(1));
-      ++st.factorizations;
-      if (s.tree.usable()) {
-        have_factor = s.tree.factorize(rows, s.bilateral, st.regularization) && s.tree.pivotRatio() > 0;
-      } else {
-        s.factor.setShift(st.regularization);
-        s.factor.factorize(s.abb);
-        have_factor = s.factor.info() == Eigen::Success && s.factor.pivotRatio() > 0;
-      }
+      have_factor = cholmod(st.regularization) && s.factor.pivotRatio() > 0;
       st.factorization_failed = !have_factor;
     }
+    st.tree_factor = use_tree;
   }
 
   // (A_BB + C_B) delta = -w_B: the bilateral rows exactly, the others fixed.
@@ -185,7 +192,7 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
       s.rhs(p) = -(rowJv(r, bodies) - r.rhs + r.cfm * r.lambda);
     }
     bool solved = true;
-    if (s.tree.usable()) {
+    if (use_tree) {
       s.delta = s.rhs;
       s.tree.solveInPlace(std::span<double>(s.delta.data(), static_cast<std::size_t>(nb)));
     } else {

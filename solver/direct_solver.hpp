@@ -7,7 +7,7 @@
 // iteration of this block Gauss-Seidel is
 //
 //   1. B exactly, U fixed:  (A_BB + C_B) delta = -w_B(current),
-//      lambda_B += delta, v += M^-1 J_B^T delta           (CHOLMOD)
+//      lambda_B += delta, v += M^-1 J_B^T delta  (tree factor or CHOLMOD)
 //   2. U by `inner_pgs_iterations` projected Gauss-Seidel sweeps, B fixed:
 //      lambda_i = clamp(lambda_i - w_i / (A_ii + cfm_i), lo_i, hi_i),
 //      friction bounds -+ mu |lambda_normal| from the current normal.

@@ -41,7 +41,8 @@
 // most kExactRows rows (Dantzig's pivoting costs O(n^3), cheap below a
 // few hundred rows, and solves the friction cone exactly where the direct
 // solver's inner PGS would meet the same mass ratio), else to the direct
-// solver (CHOLMOD on the bilateral rows, a sparse factor whose cost grows
+// solver (a sparse factor of the bilateral rows, linear in a tree's joints
+// and CHOLMOD's elsewhere, whose cost grows
 // with the fill, not the ratio) with the joint position pass.
 #include "world/method_choice.hpp"
 

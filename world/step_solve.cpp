@@ -1,5 +1,5 @@
 // Stages 6, 8 and 9 of the step: the velocity solve (PGS over the coloured
-// constraint graph for PGS islands, CHOLMOD or exact pivoting island by
+// constraint graph for PGS islands, a direct factor or exact pivoting island by
 // island for the others) and the position-correction passes; the impulses
 // kept for warm starting, joint feedback and breaking; restitution.
 #include "solver/lcp_exact.hpp"
@@ -137,7 +137,8 @@ void solveConstraints(WorldImpl& w, StepContext& ctx) {
     if (end == begin) continue;
     std::span<ConstraintRow> rows(ctx.rows.data() + begin, static_cast<size_t>(end - begin));
     if (ctx.island_method[static_cast<size_t>(isl)] == SolverMethod::Direct) {
-      // CHOLMOD for the bilateral rows, PGS sweeps for the bounded ones,
+      // A sparse factor for the bilateral rows (linear in a tree of joints,
+      // else CHOLMOD), PGS sweeps for the bounded ones,
       // alternated (solver/direct_solver.hpp); warm-started from lambda.
       DirectSolverOptions d;
       d.inner_pgs_iterations = s.iterations;

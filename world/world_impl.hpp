@@ -325,7 +325,7 @@ class WorldImpl {
   std::vector<std::int32_t> sleep_island_;   // per body slot: the island it fell asleep with
 
   StepContext ctx_;
-  DirectSolver direct_solver_;  // keeps CHOLMOD's symbolic analysis while the structure holds
+  DirectSolver direct_solver_;  // keeps the structure's analysis (tree order or CHOLMOD's) while it holds
   DirectSolver position_solver_;  // the joint position pass's own (its rows' pattern differs)
   std::unique_ptr<WorkerPool> pool_;
   std::uint64_t rng_state_ = 0;

@@ -46,7 +46,8 @@ enum class Simd { Auto, Portable, Avx2, Avx512 };
 const char* simdName(Simd s);  ///< lower-case name, as in scene files
 
 /// How an island's rows are solved: PGS sweeps over the coloured graph, the
-/// direct (CHOLMOD) block solve, the exact pivoting LCP solve
+/// direct block solve (a sparse factor of the bilateral rows: linear-time
+/// for a tree of joints, CHOLMOD otherwise), the exact pivoting LCP solve
 /// (docs/solvers-exact.md), or Auto: PGS unless the island is
 /// ill-conditioned for it (world/method_choice.cpp).
 enum class SolverMethod { PGS, Direct, LCP, Auto };

@@ -68,7 +68,6 @@ void correctJointPositions(WorldImpl& w, StepContext& ctx) {
     v.solver_index = id.isWorld() ? ctx.static_index : ctx.solver_of_body[static_cast<size_t>(id.index)];
     return v;
   };
-  std::vector<ConstraintRow>& scratch = ctx.position_scratch;
   const auto build = [&](std::vector<ConstraintRow>& rows) {
     rows.clear();
     for (const std::int32_t ji : joints) {
@@ -79,12 +78,14 @@ void correctJointPositions(WorldImpl& w, StepContext& ctx) {
       rc.cfm = s.cfm;
       rc.joint_softness = &j.def.softness;
       rc.owner = ji;
-      rc.rows = &scratch;
+      rc.rows = &rows;
       rc.correction = Correction::InRhs;
-      scratch.clear();
+      // Built in place; the joint's rows that are not rigid and bilateral
+      // (limits, motors) are dropped again (a ball or hinge joint has none).
+      const auto first = static_cast<std::ptrdiff_t>(rows.size());
       buildJointRows(j, view(j.def.body_a), view(j.def.body_b), rc, JointRowSettings{s.restitution_threshold});
-      for (const ConstraintRow& r : scratch)
-        if (rigidBilateral(r)) rows.push_back(r);
+      rows.erase(std::remove_if(rows.begin() + first, rows.end(), [](const ConstraintRow& r) { return !rigidBilateral(r); }),
+                 rows.end());
     }
   };
   const auto move = [&](std::span<const SolverBody> dx) {

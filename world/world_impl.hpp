@@ -140,7 +140,7 @@ struct StepContext {
   // The joint position pass (world/joint_position_pass.cpp).
   std::vector<std::int32_t> position_joints;
   std::vector<Real> joint_error_start;  // per joint: anchor separation as the substep began
-  std::vector<ConstraintRow> position_rows, position_scratch;
+  std::vector<ConstraintRow> position_rows;
   std::vector<SolverBody> position_bodies;
   // Geometric stiffness per body slot (world/geometric_stiffness.cpp).
   std::vector<Mat3> stiffness;

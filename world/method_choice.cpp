@@ -82,17 +82,27 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
   }
   ctx.joint_error_last.resize(w.joints_.size(), 0);
   ctx.joint_drift_run.resize(w.joints_.size(), 0);
+  const auto jointIsland = [&](const Joint& j) {
+    return j.alive && !j.broken ? std::max(islandOf(j.def.body_a), islandOf(j.def.body_b)) : -1;
+  };
+  for (const Joint& j : w.joints_)
+    if (const std::int32_t isl = jointIsland(j); isl >= 0) ++facts[static_cast<size_t>(isl)].joints;
+  // An island that leaves PGS for its mass ratio or its length needs no
+  // drift figure (and a long chain would measure every joint every step):
+  // its joints' runs start over, as a dead joint's do.
+  const auto settled = [&](const IslandFacts& f) {
+    return f.max_mass >= kMassRatio * f.min_mass || f.joints > kChainJointsPerSweep * s.iterations;
+  };
   for (size_t i = 0; i < w.joints_.size(); ++i) {
     const Joint& j = w.joints_[i];
-    if (!j.alive || j.broken) {
+    const std::int32_t isl = jointIsland(j);
+    if (!j.alive || j.broken || (isl >= 0 && settled(facts[static_cast<size_t>(isl)]))) {
       ctx.joint_error_last[i] = 0;
       ctx.joint_drift_run[i] = 0;
       continue;
     }
-    const std::int32_t isl = std::max(islandOf(j.def.body_a), islandOf(j.def.body_b));
-    if (isl < 0) continue;
+    if (isl < 0) continue;  // asleep: its run waits
     IslandFacts& f = facts[static_cast<size_t>(isl)];
-    ++f.joints;
     if (j.def.softness.isSet()) continue;
     const Real error = measureJointError(j, w.view(j.def.body_a), w.view(j.def.body_b)).linear;
     std::uint8_t& run = ctx.joint_drift_run[i];

@@ -76,27 +76,38 @@ bool positiveSemidefinite(const Mat3& s) {
 
 void stiffenRotations(WorldImpl& w, StepContext& ctx) {
   ctx.any_stiffness = false;
+  ctx.stiffened.clear();
+  ctx.true_inv_inertia.clear();
   if (!w.settings_.geometric_stiffness) return;
+  const auto add = [&](BodyId id, const Vec3& local, const Vec3& f) {
+    if (id.isWorld() || !stiffened(ctx, ctx.body_island[static_cast<size_t>(id.index)])) return;
+    const auto i = static_cast<size_t>(id.index);
+    const Body& b = w.bodies_[i];
+    if (b.rotation_locked) return;
+    // Zeroed at the first joint that adds to it (a scene without joints
+    // does not clear 72 bytes per body every substep); a slot is listed
+    // the first time it is reached.
+    if (!ctx.any_stiffness) {
+      ctx.stiffness.assign(w.bodies_.size(), Mat3::Zero());
+      ctx.stiffness_listed.assign(w.bodies_.size(), 0);
+    }
+    ctx.any_stiffness = true;
+    if (!ctx.stiffness_listed[i]) {
+      ctx.stiffness_listed[i] = 1;
+      ctx.stiffened.push_back(id.index);
+    }
+    ctx.stiffness[i] += stiffness(f, b.rotation * local);
+  };
   for (const Joint& j : w.joints_) {
     if (!j.alive || j.broken || j.def.softness.isSet()) continue;
-    for (const auto& [id, local, f] : {std::tuple{j.def.body_a, j.local_anchor_a, j.feedback.force_a},
-                                       std::tuple{j.def.body_b, j.local_anchor_b, j.feedback.force_b}}) {
-      if (id.isWorld() || !stiffened(ctx, ctx.body_island[static_cast<size_t>(id.index)])) continue;
-      const Body& b = w.bodies_[static_cast<size_t>(id.index)];
-      if (b.rotation_locked) continue;
-      // Zeroed at the first joint that adds to it (a scene without joints
-      // does not clear 72 bytes per body every substep); read only when
-      // any_stiffness is set.
-      if (!ctx.any_stiffness) ctx.stiffness.assign(w.bodies_.size(), Mat3::Zero());
-      ctx.stiffness[static_cast<size_t>(id.index)] += stiffness(f, b.orientation * local);
-      ctx.any_stiffness = true;
-    }
+    add(j.def.body_a, j.local_anchor_a, j.feedback.force_a);
+    add(j.def.body_b, j.local_anchor_b, j.feedback.force_b);
   }
   if (!ctx.any_stiffness) return;
   const Real h2 = ctx.hs * ctx.hs;
-  for (size_t i = 0; i < w.bodies_.size(); ++i) {
-    const Mat3& k = ctx.stiffness[i];
-    if (k.isZero(0)) continue;
+  for (const std::int32_t i : ctx.stiffened) {
+    const Mat3& k = ctx.stiffness[static_cast<size_t>(i)];
+    if (k.isZero(0)) continue;  // forces that cancelled (or none yet)
     const Mat3 sym = Real(0.5) * (k + k.transpose());
     Mat3 kept;
     if (positiveSemidefinite(sym)) {
@@ -110,17 +121,20 @@ void stiffenRotations(WorldImpl& w, StepContext& ctx) {
       if (!(positive.maxCoeff() > 0)) continue;
       kept = es.eigenvectors() * positive.asDiagonal() * es.eigenvectors().transpose();
     }
-    Body& b = w.bodies_[i];
+    Body& b = w.bodies_[static_cast<size_t>(i)];
+    ctx.true_inv_inertia.emplace_back(i, b.inv_inertia_world);
     // R (c 1) R^T = c 1: a sphere's or a cube's world inertia is its own.
     const Mat3 inertia = isIsotropic(b.inertia_body) ? b.inertia_body : Mat3(b.rotation * b.inertia_body * b.rotation.transpose());
     b.inv_inertia_world = (inertia + h2 * kept).inverse();
   }
 }
 
+// The bodies have not turned since stiffenRotations (the solve moves no
+// pose), so the saved inverse inertias are what updateDerived would compute.
 void restoreRotations(WorldImpl& w, StepContext& ctx) {
   if (!ctx.any_stiffness) return;
-  for (size_t i = 0; i < w.bodies_.size(); ++i)
-    if (!ctx.stiffness[i].isZero(0)) w.bodies_[i].updateDerived();
+  for (const auto& [i, inv] : ctx.true_inv_inertia) w.bodies_[static_cast<size_t>(i)].inv_inertia_world = inv;
+  ctx.true_inv_inertia.clear();
   ctx.any_stiffness = false;
 }
 

@@ -142,8 +142,13 @@ struct StepContext {
   std::vector<Real> joint_error_start;  // per joint: anchor separation as the substep began
   std::vector<ConstraintRow> position_rows;
   std::vector<SolverBody> position_bodies;
-  // Geometric stiffness per body slot (world/geometric_stiffness.cpp).
+  // Geometric stiffness per body slot (world/geometric_stiffness.cpp), the
+  // slots it reached this substep, and the true world inverse inertias of
+  // those whose rows see the augmented one (put back after the solve).
   std::vector<Mat3> stiffness;
+  std::vector<std::uint8_t> stiffness_listed;
+  std::vector<std::int32_t> stiffened;
+  std::vector<std::pair<std::int32_t, Mat3>> true_inv_inertia;
   bool any_stiffness = false;
 
   // The non-finite guard (world/step_guard.cpp).

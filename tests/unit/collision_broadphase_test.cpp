@@ -164,15 +164,21 @@ TEST(BroadPhasePairs, FilterBitsDecideWhichOverlapsPair) {
 // A proxy whose filter meets no live proxy's cannot pair: its query is not
 // run at all (no box test is counted), and the answer follows the proxies
 // that come, go and change their filters.
-TEST(BroadPhasePairs, ProxyThatCanPairWithNothingIsNotQueried) {
-  BroadPhase bp(0.1);
-  std::vector<std::pair<int, int>> pairs;
-  // A chain's links: group 2, every mask bit but 2's, side by side.
+// A chain's 20 links: group 2, every mask bit but 2's, side by side 0.5
+// apart along x (boxes of half size 0.4).
+std::vector<int> addChainLinks(BroadPhase& bp) {
   std::vector<int> links;
   for (int i = 0; i < 20; ++i) {
     links.push_back(bp.createProxy(Aabb::fromCenterHalf(Vec3(0.5 * i, 0, 0), Vec3::Constant(0.4)), i));
     bp.setFilter(links.back(), 2, ~2u);
   }
+  return links;
+}
+
+TEST(BroadPhasePairs, ProxyThatCanPairWithNothingIsNotQueried) {
+  BroadPhase bp(0.1);
+  std::vector<std::pair<int, int>> pairs;
+  const std::vector<int> links = addChainLinks(bp);
   bp.resetOverlapTests();
   bp.updatePairs(pairs);
   EXPECT_TRUE(pairs.empty());
@@ -211,11 +217,7 @@ TEST(BroadPhasePairs, ProxyThatCanPairWithNothingIsNotQueried) {
 TEST(BroadPhasePairs, ProxiesThatCanPairWithNothingLeaveTheTreeAndQueriesStillFindThem) {
   BroadPhase bp(0.1);
   std::vector<std::pair<int, int>> pairs;
-  std::vector<int> links;
-  for (int i = 0; i < 20; ++i) {
-    links.push_back(bp.createProxy(Aabb::fromCenterHalf(Vec3(0.5 * i, 0, 0), Vec3::Constant(0.4)), i));
-    bp.setFilter(links.back(), 2, ~2u);
-  }
+  const std::vector<int> links = addChainLinks(bp);
   bp.updatePairs(pairs);
   // Each link moves far (a whipping chain): out of the tree, into the list.
   for (int i = 0; i < 20; ++i)

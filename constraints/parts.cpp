@@ -78,7 +78,16 @@ Real angleNearLimits(Real s, const LimitDef& l) {
 
 int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, const Vec3& lin_a, const Vec3& ang_a,
            const Vec3& lin_b, const Vec3& ang_b, Real c, const Softness* axis_softness, Real lo, Real hi) {
-  // Built where it will stay (the rows are ~300 bytes: no copy into the list).
+  // M^-1 J^T and the diagonal from locals; the row is written once, where
+  // it will stay (the rows are ~300 bytes: no copy into the list, and no
+  // read back of what was just stored).
+  const Vec3 m_lin_a = a.inv_mass * a.lin_factor.cwiseProduct(lin_a);
+  const Vec3 m_ang_a = a.inv_inertia * ang_a;
+  const Vec3 m_lin_b = b.inv_mass * b.lin_factor.cwiseProduct(lin_b);
+  const Vec3 m_ang_b = b.inv_inertia * ang_b;
+  const Real diag = lin_a.dot(m_lin_a) + ang_a.dot(m_ang_a) + lin_b.dot(m_lin_b) + ang_b.dot(m_ang_b);
+  if (!(diag > Real(1e-300))) return -1;  // neither body can move along this row
+  const ErpCfm soft = resolveSoftness(axis_softness, *ctx.joint_softness, ctx.erp, ctx.cfm, 1 / diag, ctx.h);
   ConstraintRow& r = ctx.rows->emplace_back();
   r.body_a = a.solver_index;
   r.body_b = b.solver_index;
@@ -86,16 +95,10 @@ int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, cons
   r.j_ang_a = ang_a;
   r.j_lin_b = lin_b;
   r.j_ang_b = ang_b;
-  r.m_lin_a = a.inv_mass * a.lin_factor.cwiseProduct(lin_a);
-  r.m_ang_a = a.inv_inertia * ang_a;
-  r.m_lin_b = b.inv_mass * b.lin_factor.cwiseProduct(lin_b);
-  r.m_ang_b = b.inv_inertia * ang_b;
-  const Real diag = lin_a.dot(r.m_lin_a) + ang_a.dot(r.m_ang_a) + lin_b.dot(r.m_lin_b) + ang_b.dot(r.m_ang_b);
-  if (!(diag > Real(1e-300))) {  // neither body can move along this row
-    ctx.rows->pop_back();
-    return -1;
-  }
-  const ErpCfm soft = resolveSoftness(axis_softness, *ctx.joint_softness, ctx.erp, ctx.cfm, 1 / diag, ctx.h);
+  r.m_lin_a = m_lin_a;
+  r.m_ang_a = m_ang_a;
+  r.m_lin_b = m_lin_b;
+  r.m_ang_b = m_ang_b;
   r.cfm = soft.cfm / ctx.h;  // ODE's CFM multiplies a force; lambda is an impulse
   r.inv_diag = 1 / (diag + r.cfm);
   const bool own_softness = (axis_softness && axis_softness->isSet()) || ctx.joint_softness->isSet();

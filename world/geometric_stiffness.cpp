@@ -46,7 +46,7 @@
 // energy and the position pass all see the body's real inertia.
 #include "world/geometric_stiffness.hpp"
 
-#include <Eigen/Eigenvalues>
+#include "dynamics/positive_part.hpp"
 
 namespace cairn::detail {
 
@@ -58,19 +58,6 @@ bool stiffened(const StepContext& ctx, std::int32_t isl) {
 }
 
 Mat3 stiffness(const Vec3& f, const Vec3& r) { return f.dot(r) * Mat3::Identity() - r * f.transpose(); }
-
-// Sylvester's criterion for semidefiniteness: every principal minor of the
-// symmetric s is >= 0 (the three diagonal entries, the three 2 x 2 minors
-// and the determinant), each to round-off relative to s's largest entry: a
-// stretched joint's K has an exact zero eigenvalue (along the link), which
-// round-off leaves at +-1e-16 of the others, and keeping a part that small
-// changes the augmented inertia by nothing it can show.
-bool positiveSemidefinite(const Mat3& s) {
-  const Real a = s(0, 0), d = s(1, 1), f = s(2, 2), b = s(0, 1), c = s(0, 2), e = s(1, 2);
-  const Real scale = s.cwiseAbs().maxCoeff(), tol = Real(1e-12) * scale;
-  return a >= -tol && d >= -tol && f >= -tol && a * d - b * b >= -tol * scale && a * f - c * c >= -tol * scale &&
-         d * f - e * e >= -tol * scale && s.determinant() >= -tol * scale * scale;
-}
 
 }  // namespace
 
@@ -108,19 +95,12 @@ void stiffenRotations(WorldImpl& w, StepContext& ctx) {
   for (const std::int32_t i : ctx.stiffened) {
     const Mat3& k = ctx.stiffness[static_cast<size_t>(i)];
     if (k.isZero(0)) continue;  // forces that cancelled (or none yet)
-    const Mat3 sym = Real(0.5) * (k + k.transpose());
-    Mat3 kept;
-    if (positiveSemidefinite(sym)) {
-      // A stretched joint's K (the common case, a chain under tension):
-      // nothing to drop, so no eigendecomposition.
-      if (!(sym.trace() > 0)) continue;
-      kept = sym;
-    } else {
-      Eigen::SelfAdjointEigenSolver<Mat3> es(sym);
-      const Vec3 positive = es.eigenvalues().cwiseMax(Real(0));
-      if (!(positive.maxCoeff() > 0)) continue;
-      kept = es.eigenvectors() * positive.asDiagonal() * es.eigenvectors().transpose();
-    }
+    // A stretched joint's K (the common case, a chain under tension) is
+    // semidefinite; a link pulled at both ends off its line has one small
+    // negative eigenvalue (dynamics/positive_part.cpp takes both without
+    // an eigendecomposition).
+    const Mat3 kept = positivePart(Real(0.5) * (k + k.transpose()));
+    if (!(kept.trace() > 0)) continue;
     Body& b = w.bodies_[static_cast<size_t>(i)];
     ctx.true_inv_inertia.emplace_back(i, b.inv_inertia_world);
     // R (c 1) R^T = c 1: a sphere's or a cube's world inertia is its own.

@@ -186,7 +186,14 @@ void watchJoints(WorldImpl& w) {
     const bool awake = (!a.isWorld() && !w.body(a).asleep && w.body(a).isDynamic()) ||
                        (!b.isWorld() && !w.body(b).asleep && w.body(b).isDynamic());
     if (!awake) continue;
-    const JointError e = measureJointError(j, w.view(a), w.view(b));
+    // A ball joint's error is its anchors' distance, read from the poses
+    // (the same numbers worldPoint reads, without two views a joint).
+    const auto anchor = [&](BodyId id, const Vec3& local) {
+      return id.isWorld() ? local : Vec3(w.body(id).position + w.body(id).orientation * local);
+    };
+    const JointError e = j.def.type == JointType::Ball
+                             ? JointError{(anchor(b, j.local_anchor_b) - anchor(a, j.local_anchor_a)).norm(), 0}
+                             : measureJointError(j, w.view(a), w.view(b));
     if (!(e.linear > s.joint_drift) && !(e.angular > s.joint_drift_angle)) continue;
     const BodyId on = b.isWorld() ? a : b;
     w.diagnose(on.index, "joint drift",

@@ -116,33 +116,44 @@ void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
   Aabb box = shapeAabb(shape, b.transform() * shape.local);
   if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
   ref.proxy = broadphase_.createProxy(box, slot, Vec3::Zero(), id.index);  // a body's own shapes never pair
+  if (static_cast<size_t>(slot) < proxy_fits_.size()) proxy_fits_[static_cast<size_t>(slot)] = {};
   broadphase_.setFilter(ref.proxy, b.collision_group, b.collision_mask);
   b.shape_ids[static_cast<size_t>(index_in_body)] = slot;
 }
 
-void WorldImpl::refitProxy(const ShapeRef& ref, Real h) {
+void WorldImpl::refitProxy(std::size_t slot, Real h) {
+  const ShapeRef& ref = shapes_[slot];
   const Body& b = body(ref.body);
+  if (proxy_fits_.size() < shapes_.size()) proxy_fits_.resize(shapes_.size());
+  ProxyFit& fit = proxy_fits_[slot];
+  const Real margin = settings_.contact_margin;
+  if (fit.h == h && fit.margin == margin && fit.ccd == b.ccd && fit.x == b.position && fit.v == b.linear_velocity &&
+      fit.q.coeffs() == b.orientation.coeffs())
+    return;
+  fit = {b.position, b.linear_velocity, b.orientation, h, margin, b.ccd};
   const ShapeDesc& shape = b.shapes[static_cast<size_t>(ref.index)];
   Aabb box = shapeAabb(shape, b.transform() * shape.local);
-  if (!box.isInfinite()) box = box.expanded(reach(b, settings_.contact_margin, h));  // as registerShape does
+  if (!box.isInfinite()) box = box.expanded(reach(b, margin, h));  // as registerShape does
   broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
 }
 
 void WorldImpl::moveProxies(BodyId only, Real h) {
-  for (const ShapeRef& ref : shapes_) {
+  for (size_t slot = 0; slot < shapes_.size(); ++slot) {
+    const ShapeRef& ref = shapes_[slot];
     if (!ref.alive || (!only.isWorld() && ref.body.index != only.index)) continue;
     const Body& b = body(ref.body);
     if (only.isWorld() && (b.type == BodyType::Static || b.asleep)) continue;
-    refitProxy(ref, h);
+    refitProxy(slot, h);
   }
 }
 
 void WorldImpl::moveAwakeProxies(Real h) {
-  for (const ShapeRef& ref : shapes_) {
+  for (size_t slot = 0; slot < shapes_.size(); ++slot) {
+    const ShapeRef& ref = shapes_[slot];
     if (!ref.alive || !ctx_.moves(static_cast<size_t>(ref.body.index))) continue;  // static or asleep: still there
     const Body& b = body(ref.body);
     if (b.type == BodyType::Static || b.asleep) continue;
-    refitProxy(ref, h);
+    refitProxy(slot, h);
   }
 }
 

@@ -299,7 +299,7 @@ class WorldImpl {
   // are now, stretched along v h (world/world_contacts.cpp).
   void moveProxies(BodyId only, Real h);
   void moveAwakeProxies(Real h);  // the step's end: only the bodies that moved (StepContext::moves)
-  void refitProxy(const ShapeRef& ref, Real h);  // the shape's fat box where its body now is
+  void refitProxy(std::size_t slot, Real h);  // the shape's fat box where its body now is
 
   // ----------------------------------------------------------------------
   // The state itself. The step's stages (world/*.cpp) work on these.
@@ -315,6 +315,19 @@ class WorldImpl {
   std::vector<ShapeRef> shapes_;
   std::vector<std::int32_t> free_shapes_;
   BroadPhase broadphase_;
+  // Per shape slot, what its proxy was last fitted to: the body's pose,
+  // velocity and CCD flag, the step and the margin. A refit from the same
+  // inputs finds the same box (BroadPhase::moveProxy is idempotent), so it
+  // is skipped: the step's start would otherwise refit every awake body
+  // the previous step's end has just refitted. A cache, not state:
+  // snapshots leave it out and a restore empties it.
+  struct ProxyFit {
+    Vec3 x, v;
+    Quat q;
+    Real h = -1, margin = -1;  // h < 0: never fitted (or forgotten)
+    bool ccd = false;          // reach() stretches a CCD body's box by v h
+  };
+  std::vector<ProxyFit> proxy_fits_;
   std::vector<Contact> contacts_;      // sorted by key
   std::vector<Contact> old_contacts_;  // scratch: last step's, for matching
   std::vector<Contact> ended_contacts_;  // touching contacts removed with a body or shape between steps

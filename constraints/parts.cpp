@@ -78,8 +78,7 @@ Real angleNearLimits(Real s, const LimitDef& l) {
 
 int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, const Vec3& lin_a, const Vec3& ang_a,
            const Vec3& lin_b, const Vec3& ang_b, Real c, const Softness* axis_softness, Real lo, Real hi) {
-  // M^-1 J^T and the diagonal from locals; the row is written once, where
-  // it will stay (the rows are ~300 bytes: no copy into the list, and no
+  // M^-1 J^T and the diagonal from locals; the row is written once (no
   // read back of what was just stored).
   const Vec3 m_lin_a = a.inv_mass * a.lin_factor.cwiseProduct(lin_a);
   const Vec3 m_ang_a = a.inv_inertia * ang_a;
@@ -88,35 +87,38 @@ int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, cons
   const Real diag = lin_a.dot(m_lin_a) + ang_a.dot(m_ang_a) + lin_b.dot(m_lin_b) + ang_b.dot(m_ang_b);
   if (!(diag > Real(1e-300))) return -1;  // neither body can move along this row
   const ErpCfm soft = resolveSoftness(axis_softness, *ctx.joint_softness, ctx.erp, ctx.cfm, 1 / diag, ctx.h);
-  ConstraintRow& r = ctx.rows->emplace_back();
-  r.body_a = a.solver_index;
-  r.body_b = b.solver_index;
-  r.j_lin_a = lin_a;
-  r.j_ang_a = ang_a;
-  r.j_lin_b = lin_b;
-  r.j_ang_b = ang_b;
-  r.m_lin_a = m_lin_a;
-  r.m_ang_a = m_ang_a;
-  r.m_lin_b = m_lin_b;
-  r.m_ang_b = m_ang_b;
-  r.cfm = soft.cfm / ctx.h;  // ODE's CFM multiplies a force; lambda is an impulse
-  r.inv_diag = 1 / (diag + r.cfm);
+  const Real cfm = soft.cfm / ctx.h;  // ODE's CFM multiplies a force; lambda is an impulse
   const bool own_softness = (axis_softness && axis_softness->isSet()) || ctx.joint_softness->isSet();
+  const bool separate = ctx.correction != Correction::InRhs && !own_softness;
   const Real bias = correctionBias(ctx, soft, c, lin_a, lin_b);
-  if (ctx.correction != Correction::InRhs && !own_softness) {
-    r.correction = ctx.correction;
-    r.bias_rhs = bias;
-  } else {
-    r.rhs = bias;
-  }
-  r.lo = lo;
-  r.hi = hi;
-  r.kind = ctx.kind;
-  r.owner = ctx.owner;
-  r.owner_row = static_cast<std::int8_t>(slot);
-  if (ctx.warm && slot < static_cast<int>(ctx.warm->size())) {
-    r.lambda = std::clamp(ctx.warm_factor * (*ctx.warm)[slot], lo, hi);
-  }
+  const Real lambda = ctx.warm && slot < static_cast<int>(ctx.warm->size())
+                          ? std::clamp(ctx.warm_factor * (*ctx.warm)[slot], lo, hi)
+                          : Real(0);
+  // Every member named: value-initialising the row first (then writing
+  // it) cleared its ~300 bytes with a string store a row.
+  ctx.rows->push_back(ConstraintRow{.body_a = a.solver_index,
+                                    .body_b = b.solver_index,
+                                    .j_lin_a = lin_a,
+                                    .j_ang_a = ang_a,
+                                    .j_lin_b = lin_b,
+                                    .j_ang_b = ang_b,
+                                    .m_lin_a = m_lin_a,
+                                    .m_ang_a = m_ang_a,
+                                    .m_lin_b = m_lin_b,
+                                    .m_ang_b = m_ang_b,
+                                    .inv_diag = 1 / (diag + cfm),
+                                    .rhs = separate ? Real(0) : bias,
+                                    .cfm = cfm,
+                                    .lo = lo,
+                                    .hi = hi,
+                                    .lambda = lambda,
+                                    .mu = 0,
+                                    .normal_row = -1,
+                                    .kind = ctx.kind,
+                                    .owner = ctx.owner,
+                                    .owner_row = static_cast<std::int8_t>(slot),
+                                    .bias_rhs = separate ? bias : Real(0),
+                                    .correction = separate ? ctx.correction : Correction::InRhs});
   return static_cast<int>(ctx.rows->size() - 1);
 }
 

@@ -60,26 +60,27 @@ bool dropOneNegative(const Mat3& s, Real scale, Real det, Real dq0, Mat3& kept) 
   return true;
 }
 
-}  // namespace
-
 // Every principal minor of the symmetric s is >= 0 (the three diagonal
 // entries, the three 2 x 2 minors and the determinant), each to round-off
 // relative to s's largest entry: a stretched joint's K has an exact zero
 // eigenvalue (along the link), which round-off leaves at +-1e-16 of the
 // others, and keeping a part that small changes nothing it can show.
-bool positiveSemidefinite(const Mat3& s) {
+bool positiveSemidefinite(const Mat3& s, Real scale) {
   const Real a = s(0, 0), d = s(1, 1), f = s(2, 2), b = s(0, 1), c = s(0, 2), e = s(1, 2);
-  const Real scale = s.cwiseAbs().maxCoeff(), tol = Real(1e-12) * scale;
+  const Real tol = Real(1e-12) * scale;
   return a >= -tol && d >= -tol && f >= -tol && a * d - b * b >= -tol * scale && a * f - c * c >= -tol * scale &&
          d * f - e * e >= -tol * scale && s.determinant() >= -tol * scale * scale;
 }
 
+}  // namespace
+
 Mat3 positivePart(const Mat3& s) {
-  if (positiveSemidefinite(s)) return s;
+  const Real scale = s.cwiseAbs().maxCoeff();
+  if (positiveSemidefinite(s, scale)) return s;
   Real det, dq0;
   shiftedDeterminant(s, 0, det, dq0);
   Mat3 kept;
-  if (dropOneNegative(s, s.cwiseAbs().maxCoeff(), det, dq0, kept)) return kept;
+  if (dropOneNegative(s, scale, det, dq0, kept)) return kept;
   const Eigen::SelfAdjointEigenSolver<Mat3> es(s);
   return es.eigenvectors() * es.eigenvalues().cwiseMax(Real(0)).asDiagonal() * es.eigenvectors().transpose();
 }

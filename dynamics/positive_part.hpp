@@ -10,14 +10,11 @@
 
 namespace cairn {
 
-// Sylvester's criterion, to round-off relative to s's largest entry.
-bool positiveSemidefinite(const Mat3& s);
-
 // The positive part of the symmetric s. Three routes, cheapest first:
-// s already semidefinite (returned as it is); exactly one negative
-// eigenvalue (found by Newton's method on det(s - lambda 1), its
-// eigenvector by a cross product, and s - lambda v v^T returned); else
-// Eigen's symmetric eigensolver.
+// s already semidefinite by Sylvester's criterion, to round-off (returned
+// as it is); exactly one negative eigenvalue (found by Newton's method on
+// det(s - lambda 1), its eigenvector by a cross product, and
+// s - lambda v v^T returned); else Eigen's symmetric eigensolver.
 Mat3 positivePart(const Mat3& s);
 
 }  // namespace cairn

@@ -552,7 +552,7 @@ void ioWorld(Ar& ar, WorldImpl& w) {
   if constexpr (Ar::reading) {
     checkBroadPhaseState(w, proxies, free_proxy, ar.object());
     w.broadphase_.restore(proxies, free_proxy);
-    w.proxy_fits_.clear();
+    w.forgetProxyFits();
     // The filter bits are the bodies' (not stored twice).
     for (const ShapeRef& ref : w.shapes_)
       if (ref.alive) {

@@ -292,7 +292,7 @@ void World::setCollisionFilter(BodyId id, std::uint32_t group, std::uint32_t mas
   b.collision_mask = mask;
   for (const std::int32_t slot : b.shape_ids)
     if (slot >= 0) impl_->broadphase_.setFilter(impl_->shapes_[static_cast<size_t>(slot)].proxy, group, mask);
-  impl_->proxy_fits_.clear();  // the next refit decides again whether a proxy stays in the tree
+  impl_->forgetProxyFits();  // the next refit decides again whether a proxy stays in the tree
   impl_->wakeBody(id);
 }
 

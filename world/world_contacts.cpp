@@ -116,7 +116,8 @@ void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
   Aabb box = shapeAabb(shape, b.transform() * shape.local);
   if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
   ref.proxy = broadphase_.createProxy(box, slot, Vec3::Zero(), id.index);  // a body's own shapes never pair
-  if (static_cast<size_t>(slot) < proxy_fits_.size()) proxy_fits_[static_cast<size_t>(slot)] = {};
+  proxy_fits_.resize(shapes_.size());  // the slot's box is fitted afresh
+  proxy_fits_[static_cast<size_t>(slot)] = {};
   broadphase_.setFilter(ref.proxy, b.collision_group, b.collision_mask);
   b.shape_ids[static_cast<size_t>(index_in_body)] = slot;
 }
@@ -124,7 +125,6 @@ void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
 void WorldImpl::refitProxy(std::size_t slot, Real h) {
   const ShapeRef& ref = shapes_[slot];
   const Body& b = body(ref.body);
-  if (proxy_fits_.size() < shapes_.size()) proxy_fits_.resize(shapes_.size());
   ProxyFit& fit = proxy_fits_[slot];
   const Real margin = settings_.contact_margin;
   if (fit.h == h && fit.margin == margin && fit.ccd == b.ccd && fit.x == b.position && fit.v == b.linear_velocity &&
@@ -136,6 +136,8 @@ void WorldImpl::refitProxy(std::size_t slot, Real h) {
   if (!box.isInfinite()) box = box.expanded(reach(b, margin, h));  // as registerShape does
   broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
 }
+
+void WorldImpl::forgetProxyFits() { proxy_fits_.assign(shapes_.size(), ProxyFit{}); }
 
 void WorldImpl::moveProxies(BodyId only, Real h) {
   for (size_t slot = 0; slot < shapes_.size(); ++slot) {

@@ -300,6 +300,7 @@ class WorldImpl {
   void moveProxies(BodyId only, Real h);
   void moveAwakeProxies(Real h);  // the step's end: only the bodies that moved (StepContext::moves)
   void refitProxy(std::size_t slot, Real h);  // the shape's fat box where its body now is
+  void forgetProxyFits();  // every proxy refitted at its next move (proxy_fits_)
 
   // ----------------------------------------------------------------------
   // The state itself. The step's stages (world/*.cpp) work on these.
@@ -319,8 +320,9 @@ class WorldImpl {
   // velocity and CCD flag, the step and the margin. A refit from the same
   // inputs finds the same box (BroadPhase::moveProxy is idempotent), so it
   // is skipped: the step's start would otherwise refit every awake body
-  // the previous step's end has just refitted. A cache, not state:
-  // snapshots leave it out and a restore empties it.
+  // the previous step's end has just refitted. A cache, not state, one
+  // entry per shape slot (registerShape adds them): snapshots leave it out
+  // and a restore forgets it.
   struct ProxyFit {
     Vec3 x, v;
     Quat q;

@@ -38,10 +38,6 @@ void unite(std::vector<std::int32_t>& parent, std::int32_t a, std::int32_t b) {
   else parent[static_cast<size_t>(a)] = b;
 }
 
-bool kinematicMoving(const Body& b) {
-  return b.type == BodyType::Kinematic && b.linear_velocity.squaredNorm() + b.angular_velocity.squaredNorm() > 0;
-}
-
 }  // namespace
 
 void WorldImpl::wakeIsland(std::int32_t island) {
@@ -70,14 +66,16 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
   enum : std::uint8_t { kAlive = 1, kDynamic = 2, kKinematic = 4, kAsleep = 8, kKinematicMoving = 16 };
   std::vector<std::uint8_t>& flags = ctx.body_flags;
   flags.assign(static_cast<size_t>(n), 0);
+  bool anything_moves = false;  // moving(), below, of any slot
   for (size_t i = 0; i < flags.size(); ++i) {
     const Body& b = w.bodies_[i];
     std::uint8_t f = b.alive ? kAlive : 0;
     if (b.isDynamic()) f |= kDynamic;
     if (b.type == BodyType::Kinematic) f |= kKinematic;
     if (b.asleep) f |= kAsleep;
-    if (kinematicMoving(b)) f |= kKinematicMoving;
+    if (b.isMovingKinematic()) f |= kKinematicMoving;
     flags[i] = f;
+    anything_moves = anything_moves || (f & kKinematicMoving) || ((f & kDynamic) && !(f & kAsleep));
   }
   const auto has = [&](BodyId id, std::uint8_t bit) { return !id.isWorld() && (flags[static_cast<size_t>(id.index)] & bit); };
   const auto moving = [&](BodyId id) {
@@ -85,6 +83,10 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
   };
   // Wake sleeping islands touched by something that moves: gather the
   // islands first, then wake them in one pass over the bodies.
+  // When nothing moves (a world asleep), nothing wakes and no island is
+  // numbered: the walks over the contacts and joints below are skipped
+  // (they were most of an asleep pyramid's islands stage, a contact being
+  // 700 bytes apart from the next).
   std::vector<std::int32_t>& to_wake = ctx.wake_list;
   to_wake.clear();
   const auto touch = [&](BodyId sleeper, BodyId other) {
@@ -92,15 +94,17 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
     w.body(sleeper).sleep_timer = 0;
     to_wake.push_back(w.sleep_island_[static_cast<size_t>(sleeper.index)]);
   };
-  for (const Contact& c : w.contacts_) {
-    if (!c.enabled) continue;
-    touch(c.body_a, c.body_b);
-    touch(c.body_b, c.body_a);
-  }
-  for (const Joint& j : w.joints_) {
-    if (!j.alive || j.broken) continue;
-    touch(j.def.body_a, j.def.body_b);
-    touch(j.def.body_b, j.def.body_a);
+  if (anything_moves) {
+    for (const Contact& c : w.contacts_) {
+      if (!c.enabled) continue;
+      touch(c.body_a, c.body_b);
+      touch(c.body_b, c.body_a);
+    }
+    for (const Joint& j : w.joints_) {
+      if (!j.alive || j.broken) continue;
+      touch(j.def.body_a, j.def.body_b);
+      touch(j.def.body_b, j.def.body_a);
+    }
   }
   if (!to_wake.empty()) {
     std::sort(to_wake.begin(), to_wake.end());
@@ -118,12 +122,14 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
 
   ctx.uf_parent.resize(static_cast<size_t>(n));
   for (std::int32_t i = 0; i < n; ++i) ctx.uf_parent[static_cast<size_t>(i)] = i;
-  for (const Contact& c : w.contacts_)
-    if (c.enabled && has(c.body_a, kDynamic) && has(c.body_b, kDynamic))
-      unite(ctx.uf_parent, c.body_a.index, c.body_b.index);
-  for (const Joint& j : w.joints_)
-    if (j.alive && !j.broken && has(j.def.body_a, kDynamic) && has(j.def.body_b, kDynamic))
-      unite(ctx.uf_parent, j.def.body_a.index, j.def.body_b.index);
+  if (anything_moves) {  // else no body below is awake: the sets are never read
+    for (const Contact& c : w.contacts_)
+      if (c.enabled && has(c.body_a, kDynamic) && has(c.body_b, kDynamic))
+        unite(ctx.uf_parent, c.body_a.index, c.body_b.index);
+    for (const Joint& j : w.joints_)
+      if (j.alive && !j.broken && has(j.def.body_a, kDynamic) && has(j.def.body_b, kDynamic))
+        unite(ctx.uf_parent, j.def.body_a.index, j.def.body_b.index);
+  }
 
   // Number the islands of awake dynamic bodies in body order. The same
   // walk lists the kinematic bodies and counts the sleepers, so that no
@@ -206,15 +212,21 @@ void updateSleep(WorldImpl& w, StepContext& ctx) {
     // closes the excess geometrically (by 1 - contact_erp a step), so it
     // is never exactly zero: a tolerance lets a finished push-out sleep.
     const Real done = kPushDone * s.slop;
-    for (const Contact& c : w.contacts_) {
-      if (!c.enabled || c.count == 0) continue;
-      const std::int32_t isl = std::max(c.body_a.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(c.body_a.index)],
-                                        c.body_b.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(c.body_b.index)]);
-      // Only an island about to sleep needs the look (an awake pyramid's
-      // contacts cost this stage most of its time).
-      if (isl < 0 || island_min[static_cast<size_t>(isl)] < s.sleep_time) continue;
-      if (w.contactDepth(c) > s.slop + done) island_min[static_cast<size_t>(isl)] = 0;
-    }
+    // The walks below only keep awake an island about to sleep; with none
+    // (an awake scene, or no island at all) they are skipped, a contact
+    // being 700 bytes apart from the next.
+    const bool about_to_sleep =
+        std::any_of(island_min.begin(), island_min.end(), [&](Real m) { return m >= s.sleep_time; });
+    if (about_to_sleep)
+      for (const Contact& c : w.contacts_) {
+        if (!c.enabled || c.count == 0) continue;
+        const std::int32_t isl = std::max(c.body_a.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(c.body_a.index)],
+                                          c.body_b.isWorld() ? -1 : ctx.body_island[static_cast<size_t>(c.body_b.index)]);
+        // Only an island about to sleep needs the look (an awake pyramid's
+        // contacts cost this stage most of its time).
+        if (isl < 0 || island_min[static_cast<size_t>(isl)] < s.sleep_time) continue;
+        if (w.contactDepth(c) > s.slop + done) island_min[static_cast<size_t>(isl)] = 0;
+      }
     for (std::int32_t si = 1; si <= ctx.dynamic_count && si < static_cast<std::int32_t>(ctx.pseudo.size()); ++si) {
       const SolverBody& p = ctx.pseudo[static_cast<size_t>(si)];
       if (ctx.hs * p.v.norm() <= done) continue;
@@ -222,10 +234,10 @@ void updateSleep(WorldImpl& w, StepContext& ctx) {
       if (isl >= 0) island_min[static_cast<size_t>(isl)] = 0;
     }
     // An island touching a moving kinematic body stays awake.
-    if (!ctx.kinematic_bodies.empty())
+    if (about_to_sleep && !ctx.kinematic_bodies.empty())
       for (const Contact& c : w.contacts_) {
         for (const auto& [kin, dyn] : {std::pair{c.body_a, c.body_b}, std::pair{c.body_b, c.body_a}}) {
-          if (kin.isWorld() || dyn.isWorld() || !kinematicMoving(w.body(kin))) continue;
+          if (kin.isWorld() || dyn.isWorld() || !w.body(kin).isMovingKinematic()) continue;
           const std::int32_t isl = ctx.body_island[static_cast<size_t>(dyn.index)];
           if (isl >= 0) island_min[static_cast<size_t>(isl)] = 0;
         }

@@ -82,6 +82,14 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
   }
   ctx.joint_error_last.resize(w.joints_.size(), 0);
   ctx.joint_drift_run.resize(w.joints_.size(), 0);
+  if (n == 0) {  // every body asleep or static: only the dead joints' runs start over (the loop below)
+    for (size_t i = 0; i < w.joints_.size(); ++i) {
+      if (w.joints_[i].alive && !w.joints_[i].broken) continue;
+      ctx.joint_error_last[i] = 0;
+      ctx.joint_drift_run[i] = 0;
+    }
+    return;
+  }
   const auto jointIsland = [&](const Joint& j) {
     return j.alive && !j.broken ? std::max(islandOf(j.def.body_a), islandOf(j.def.body_b)) : -1;
   };

@@ -230,8 +230,12 @@ Real watchPenetration(WorldImpl& w, StepContext& ctx) {
   const Vec3 up = g > 0 ? Vec3(-w.gravity_ / g) : Vec3::Zero();
   ctx.supports.clear();
   // The depths first, each contact on its own (on the pool's threads when
-  // there are many), then the reports in contact order.
-  const auto still = [&](const Contact& c) { return !movedInStep(ctx, c.body_a) && !movedInStep(ctx, c.body_b); };
+  // there are many), then the reports in contact order. With no solver body
+  // but the world's nothing moved: every contact is still, its depth kept.
+  const bool anything_moved = ctx.solver_count > 1;
+  const auto still = [&](const Contact& c) {
+    return !anything_moved || (!movedInStep(ctx, c.body_a) && !movedInStep(ctx, c.body_b));
+  };
   const auto depths = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       Contact& c = w.contacts_[static_cast<size_t>(i)];
@@ -239,11 +243,17 @@ Real watchPenetration(WorldImpl& w, StepContext& ctx) {
     }
   };
   const int count = static_cast<int>(w.contacts_.size());
-  if (w.pool_ && count >= kParallelContacts) w.pool_->parallelFor(count, depths);
-  else depths(0, count);
+  if (anything_moved) {
+    if (w.pool_ && count >= kParallelContacts) w.pool_->parallelFor(count, depths);
+    else depths(0, count);
+  }
+  // The same walk counts the step's contacts for StepStats (the list does
+  // not change after this stage).
   Real deepest = 0;
   for (Contact& c : w.contacts_) {
     if (!c.enabled) continue;
+    ++w.stats_.contacts;
+    w.stats_.contact_points += c.count;
     if (still(c)) {
       deepest = std::max(deepest, c.depth_after);
       continue;

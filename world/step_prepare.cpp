@@ -189,10 +189,11 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
     if (j.alive && !j.broken) ctx.joint_island[i] = islandOf(ctx, j.def.body_a, j.def.body_b);
   }
   ctx.contact_island.assign(w.contacts_.size(), -1);
-  for (size_t i = 0; i < w.contacts_.size(); ++i) {
-    const Contact& c = w.contacts_[i];
-    if (c.enabled && c.count > 0) ctx.contact_island[i] = islandOf(ctx, c.body_a, c.body_b);
-  }
+  if (ctx.island_count > 0)  // else every body is asleep or static: no contact has an island
+    for (size_t i = 0; i < w.contacts_.size(); ++i) {
+      const Contact& c = w.contacts_[i];
+      if (c.enabled && c.count > 0) ctx.contact_island[i] = islandOf(ctx, c.body_a, c.body_b);
+    }
 
   // 2. The PGS islands' constraints, and each dynamic body's level: its
   // distance, in constraints, from a static or kinematic body (breadth

@@ -206,10 +206,13 @@ Real WorldImpl::contactDepth(const Contact& c) const {
 
 namespace {
 
-// A pair of bodies of which nothing moves this step: both asleep or not
-// dynamic, one asleep. Its contacts stay as they were.
+// A pair of bodies of which nothing moves this step: each asleep, static or
+// kinematic without a velocity, one asleep. Its contacts stay as they were.
+// (A moving kinematic body must be collided: its contact is what wakes the
+// sleeper it reaches.)
 bool pairAtRest(const Body& a, const Body& b) {
-  return (a.asleep || !a.isDynamic()) && (b.asleep || !b.isDynamic()) && (a.asleep || b.asleep);
+  const auto still = [](const Body& x) { return x.asleep || (!x.isDynamic() && !x.isMovingKinematic()); };
+  return still(a) && still(b) && (a.asleep || b.asleep);
 }
 
 // Whether every candidate pair is at rest and may still collide.
@@ -315,9 +318,13 @@ void collide(WorldImpl& w, StepContext& ctx) {
   // (a fully asleep pile-1000's collide was mostly that copy); instead the
   // contacts stay where they are, and last step's list is emptied so that
   // the events see nothing end.
-  if (!pairs_changed && pairsAtRest(w)) {
+  const bool at_rest = !pairs_changed && pairsAtRest(w);
+  if (at_rest) {
     old_contacts_.clear();
-    for (Contact& c : contacts_) c.carried = true;
+    for (Contact& c : contacts_) {  // and warm started as below, in the same walk
+      c.carried = true;
+      c.began = !c.touching;
+    }
   } else {
     // 2. Narrowphase over the candidate pairs, matching last step's contacts.
     std::swap(old_contacts_, contacts_);
@@ -398,8 +405,10 @@ void collide(WorldImpl& w, StepContext& ctx) {
   const auto warmRange = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) warmStart(contacts_[static_cast<size_t>(i)]);
   };
-  if (w.pool_ && contact_count >= kParallelPairs) w.pool_->parallelFor(contact_count, warmRange);
-  else warmRange(0, contact_count);
+  if (!at_rest) {  // at rest, done above
+    if (w.pool_ && contact_count >= kParallelPairs) w.pool_->parallelFor(contact_count, warmRange);
+    else warmRange(0, contact_count);
+  }
 
   // 4. The user's callback may veto or modify each contact.
   if (w.contact_callback_) {

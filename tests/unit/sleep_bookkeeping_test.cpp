@@ -77,5 +77,53 @@ TEST(SleepBookkeeping, ForceAppliedToAStaticBodyIsClearedAfterTheStep) {
   EXPECT_EQ(in.body(ground).torque, Vec3::Zero());
 }
 
+// A world all asleep: the step skips its walks over the contacts (nothing
+// wakes, no island forms, no depth changes), yet reports what is there.
+// Nothing moves, so each later step's contact count, point count and
+// deepest penetration are those of the step the stack fell asleep in, to
+// the bit.
+TEST(SleepBookkeeping, AWorldAllAsleepReportsTheContactsAndDepthOfTheStepItFellAsleepIn) {
+  World w(Vec3(0, -9.81, 0));
+  w.createBody(scenarios::ground());
+  w.createBody(test::boxDef("bottom", Vec3(0, 0.5, 0)));
+  w.createBody(test::boxDef("top", Vec3(0.1, 1.5, 0)));
+  for (int k = 0; k < 600 && w.lastStepStats().sleeping_bodies < 2; ++k) w.step(Real(1) / 60);
+  const StepStats fell = w.lastStepStats();
+  ASSERT_EQ(fell.sleeping_bodies, 2);
+  ASSERT_EQ(fell.contacts, 2);  // ground-bottom, bottom-top
+  ASSERT_GT(fell.max_penetration, 0);
+  for (int k = 0; k < 30; ++k) {
+    w.step(Real(1) / 60);
+    const StepStats& s = w.lastStepStats();
+    EXPECT_EQ(s.islands, 0);
+    EXPECT_EQ(s.contacts, fell.contacts);
+    EXPECT_EQ(s.contact_points, fell.contact_points);
+    EXPECT_EQ(s.max_penetration, fell.max_penetration);
+  }
+}
+
+// A kinematic body moving into a sleeping box wakes it (the one thing that
+// moves in an otherwise sleeping world), and pushes it: the box, 1 m
+// wide, ends more than 10 cm from where it slept.
+TEST(SleepBookkeeping, AMovingKinematicBodyWakesTheSleepingBoxItReaches) {
+  World w(Vec3(0, -9.81, 0));
+  w.createBody(scenarios::ground());
+  const BodyId box = w.createBody(test::boxDef("box", Vec3(0, 0.5, 0)));
+  for (int k = 0; k < 120; ++k) w.step(Real(1) / 60);
+  ASSERT_TRUE(w.isAsleep(box));
+  const Vec3 slept = cairn::detail::internals(w).body(box).position;
+  BodyDef pusher = test::boxDef("pusher", Vec3(-2, 0.5, 0));
+  pusher.type = BodyType::Kinematic;
+  pusher.linear_velocity = Vec3(1, 0, 0);  // reaches the box after about 1 s
+  w.createBody(pusher);
+  bool woke = false;
+  for (int k = 0; k < 120; ++k) {
+    w.step(Real(1) / 60);
+    woke = woke || !w.isAsleep(box);
+  }
+  EXPECT_TRUE(woke);
+  EXPECT_GT((cairn::detail::internals(w).body(box).position - slept).norm(), 0.1);
+}
+
 }  // namespace
 }  // namespace cairn

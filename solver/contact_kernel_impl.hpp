@@ -385,8 +385,10 @@ struct Kernel {
           const ContactBatch::Point& q = b.p[i];
           addRow(sum, n, ld3(q.ran, o), ld3(q.rbn, o), ld(q.lambda + o));
           const V3 t1 = ld3(q.t, o);
+          // The tangent rows in use (a row past friction_rows holds zeros: it would add nothing).
           addRow(sum, t1, ld3(q.rat[0], o), ld3(q.rbt[0], o), ld(q.lambda_t[0] + o));
-          addRow(sum, cross(n, t1), ld3(q.rat[1], o), ld3(q.rbt[1], o), ld(q.lambda_t[1] + o));
+          if (p.friction_rows > 1)
+            addRow(sum, cross(n, t1), ld3(q.rat[1], o), ld3(q.rbt[1], o), ld(q.lambda_t[1] + o));
         }
         applySum(s, m, sum);
         scatter(bodies, b, o, s, p.dynamic_end, allTrue());
@@ -521,8 +523,8 @@ struct Kernel {
           for (int i = 0; i < points; ++i) {
             ContactBatch::Point& q = b.p[i];
             st(q.dir_n + o, newDir(ld(q.dir_n + o), ld(q.change_n + o)));
-            st(q.dir_t[0] + o, newDir(ld(q.dir_t[0] + o), ld(q.change_t[0] + o)));
-            st(q.dir_t[1] + o, newDir(ld(q.dir_t[1] + o), ld(q.change_t[1] + o)));
+            for (int k = 0; k < p.friction_rows; ++k)
+              st(q.dir_t[k] + o, newDir(ld(q.dir_t[k] + o), ld(q.change_t[k] + o)));
           }
           continue;
         }
@@ -543,7 +545,7 @@ struct Kernel {
           addRow(sum, n, ld3(q.ran, o), ld3(q.rbn, o), ln - l);
           const V3 t1 = ld3(q.t, o);
           const D limit = mu * ln;
-          for (int k = 0; k < 2; ++k) {
+          for (int k = 0; k < p.friction_rows; ++k) {  // a row past them stays zero
             const D lt = ld(q.lambda_t[k] + o), dt = ld(q.dir_t[k] + o);
             const D next = sel(apply, vmin(vmax(lt + bstep * dt, -limit), limit), lt);
             st(q.lambda_t[k] + o, next);

@@ -82,14 +82,6 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
   }
   ctx.joint_error_last.resize(w.joints_.size(), 0);
   ctx.joint_drift_run.resize(w.joints_.size(), 0);
-  if (n == 0) {  // every body asleep or static: only the dead joints' runs start over (the loop below)
-    for (size_t i = 0; i < w.joints_.size(); ++i) {
-      if (w.joints_[i].alive && !w.joints_[i].broken) continue;
-      ctx.joint_error_last[i] = 0;
-      ctx.joint_drift_run[i] = 0;
-    }
-    return;
-  }
   const auto jointIsland = [&](const Joint& j) {
     return j.alive && !j.broken ? std::max(islandOf(j.def.body_a), islandOf(j.def.body_b)) : -1;
   };
@@ -118,11 +110,12 @@ void chooseIslandMethods(WorldImpl& w, StepContext& ctx) {
     ctx.joint_error_last[i] = error;
     f.drifting = f.drifting || run >= kDriftSteps || error > kDriftAtOnce;
   }
-  for (const Contact& c : w.contacts_) {
-    if (!c.enabled || c.count == 0) continue;
-    const std::int32_t isl = std::max(islandOf(c.body_a), islandOf(c.body_b));
-    if (isl >= 0) facts[static_cast<size_t>(isl)].contact_points += c.count;
-  }
+  if (n > 0)  // else every body is asleep or static: no contact has an island (a walk over 700-byte contacts)
+    for (const Contact& c : w.contacts_) {
+      if (!c.enabled || c.count == 0) continue;
+      const std::int32_t isl = std::max(islandOf(c.body_a), islandOf(c.body_b));
+      if (isl >= 0) facts[static_cast<size_t>(isl)].contact_points += c.count;
+    }
   for (size_t isl = 0; isl < n; ++isl) {
     const IslandFacts& f = facts[isl];
     MethodReason why = MethodReason::WellConditioned;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ranges>
 
 namespace cairn {
 
@@ -113,6 +114,16 @@ void groupMomentum(GraphProblem& p, const RowGroup& g, std::span<SolverBody> bod
 constexpr double kParallelWork = 4;
 constexpr double kGroupWork = 1.0 / 8;
 
+// Below this much work a pass (in batch visits), the flow schedule
+// (colour_flow.hpp) is not planned. Planning costs about a batch visit per
+// item, once a step, and a small island's colours rarely leave a second
+// thread anything to do: pyramid-20's 111 batches, one to three a colour,
+// planned a critical path of 110 visits (no gain), and the planning alone
+// made its solve 3% slower on two threads; pyramid-40's 370 planned 276
+// and solved 1.2 times faster than with the colours' barriers
+// (docs/performance.md).
+constexpr double kFlowWork = 256;
+
 // Runs fn(begin, end) over [0, count), on the pool's threads if there is one
 // and the loop's `work` (in batch visits) pays for it.
 template <class F>
@@ -132,17 +143,23 @@ ContactSweepParams sweepParams(const GraphProblem& p, const GraphSolveOptions& o
   return sp;
 }
 
-// The items of a colour: its row groups, then its manifold batches. Every
-// item writes only its own constraints' bodies, so any split of the items
-// among threads gives the same result.
+// The items [begin, end) of a colour, which numbers its row groups, then
+// its manifold batches.
+template <class Groups, class Batches>
+void forItems(const GraphColour& c, int begin, int end, Groups& groups_fn, Batches& batches_fn) {
+  const int groups = c.group_end - c.group_begin;
+  for (int i = begin; i < std::min(end, groups); ++i) groups_fn(c.group_begin + i);
+  const int b0 = std::max(begin, groups) - groups, b1 = end - groups;
+  if (b1 > b0) batches_fn(c.batch_begin + b0, c.batch_begin + b1);
+}
+
+// The items of a colour. Every item writes only its own constraints'
+// bodies, so any split of the items among threads gives the same result.
 template <class Groups, class Batches>
 void forColour(const GraphColour& c, WorkerPool* pool, Groups&& groups_fn, Batches&& batches_fn) {
   const int groups = c.group_end - c.group_begin, batches = c.batch_end - c.batch_begin;
-  forRange(pool, groups + batches, batches + kGroupWork * groups, [&](int begin, int end) {
-    for (int i = begin; i < std::min(end, groups); ++i) groups_fn(c.group_begin + i);
-    const int b0 = std::max(begin, groups) - groups, b1 = end - groups;
-    if (b1 > b0) batches_fn(c.batch_begin + b0, c.batch_begin + b1);
-  });
+  forRange(pool, groups + batches, batches + kGroupWork * groups,
+           [&](int begin, int end) { forItems(c, begin, end, groups_fn, batches_fn); });
 }
 
 // What one thread sweeps: a run of colours with their batches and groups,
@@ -203,6 +220,34 @@ void forParts(const GraphProblem& p, const GraphSolveOptions& o, F&& fn) {
   o.pool->parallelFor(parts, [&](int begin, int end) {
     for (int k = begin; k < end; ++k) fn(k, partOf(p, o, k), alone);
   });
+}
+
+// Whether the passes over this problem follow its flow schedule
+// (colour_flow.hpp): one part in colour order with a pool, and a schedule
+// that saves at least the work a handover to the pool costs.
+bool useFlow(GraphProblem& p, const GraphSolveOptions& o) {
+  if (!o.pool || o.randomize_order || partCount(p, o) != 1) return false;
+  const double work = static_cast<double>(p.batches.size()) + kGroupWork * static_cast<double>(p.groups.size());
+  if (work < kFlowWork) return false;
+  if (!p.flow_planned) {
+    p.flow_planned = true;
+    p.flow_ready = p.flow.plan(p, o.pool->threads(), o.dynamic_end, kParallelWork);
+  }
+  return p.flow_ready;
+}
+
+// One pass over `colours` in turn: by the flow schedule (`flow`: then the
+// colours are all of them, in order), else colour by colour.
+template <class Colours, class Groups, class Batches>
+void forColours(GraphProblem& p, bool flow, WorkerPool* pool, const Colours& colours, Groups&& groups_fn,
+                Batches&& batches_fn) {
+  if (flow) {
+    p.flow.run(*pool, [&](const FlowItem& it) {
+      forItems(p.colours[static_cast<size_t>(it.colour)], it.item, it.item + 1, groups_fn, batches_fn);
+    });
+    return;
+  }
+  for (const std::int32_t ci : colours) forColour(p.colours[static_cast<size_t>(ci)], pool, groups_fn, batches_fn);
 }
 
 // Each island's largest change and impulse of the sweep, gathered in
@@ -298,35 +343,32 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
                           std::span<SolverBody> bodies, const GraphSolveOptions& o, std::uint64_t& rng_state) {
   GraphSolveStats stats;
   double* body_data = bodies.front().v.data();
-  const auto colour = [&](std::int32_t ci) -> const GraphColour& { return p.colours[static_cast<size_t>(ci)]; };
+  const bool flow = useFlow(p, o);
 
   // Warm start: the carried impulses act before the first sweep.
   const ContactSweepParams warm = sweepParams(p, o, false);
-  for (std::int32_t ci = part.colour_begin; ci < part.colour_end; ++ci)
-    forColour(
-        colour(ci), o.pool,
-        [&](std::int32_t gi) {
-          const RowGroup& g = p.groups[static_cast<size_t>(gi)];
-          for (std::int32_t k = g.begin; k < g.end; ++k) {
-            const ConstraintRow& r = p.rows[static_cast<size_t>(k)];
-            if (r.lambda != 0) applyRow(r, bodies, o.dynamic_end, r.lambda);
-          }
-        },
-        [&](int b0, int b1) { o.kernels->warm_start(p.batches.data(), b0, b1, body_data, warm); });
+  forColours(
+      p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end),
+      [&](std::int32_t gi) {
+        const RowGroup& g = p.groups[static_cast<size_t>(gi)];
+        for (std::int32_t k = g.begin; k < g.end; ++k) {
+          const ConstraintRow& r = p.rows[static_cast<size_t>(k)];
+          if (r.lambda != 0) applyRow(r, bodies, o.dynamic_end, r.lambda);
+        }
+      },
+      [&](int b0, int b1) { o.kernels->warm_start(p.batches.data(), b0, b1, body_data, warm); });
 
   const ContactSweepParams sp = sweepParams(p, o, o.nncg);
   const bool batches = part.batch_end > part.batch_begin;
   for (int it = 0; it < o.iterations; ++it) {
     if (o.randomize_order || it == 0) orderColours(order, part, o.randomize_order, rng_state);
-    for (const std::int32_t ci : order)
-      forColour(
-          colour(ci), o.pool, [&](std::int32_t gi) { solveGroup(p, gi, bodies, o, o.nncg); },
-          [&](int b0, int b1) { o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, sp); });
+    forColours(
+        p, flow, o.pool, order, [&](std::int32_t gi) { solveGroup(p, gi, bodies, o, o.nncg); },
+        [&](int b0, int b1) { o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, sp); });
     if (batches)  // a jointed scene without contacts has no friction pass to walk
-      for (const std::int32_t ci : order)
-        forColour(
-            colour(ci), o.pool, [](std::int32_t) {},
-            [&](int b0, int b1) { o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); });
+      forColours(
+          p, flow, o.pool, order, [](std::int32_t) {},
+          [&](int b0, int b1) { o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); });
     reduceSweep(p, part, true);
     stats.last_max_delta = 0;
     for (std::int32_t i = part.island_begin; i < part.island_end; ++i)
@@ -337,13 +379,10 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
     // No momentum after the last sweep: the result must be a PGS iterate.
     if (o.nncg && it + 1 < o.iterations) {
       islandBetas(p, part);
-      for (const std::int32_t ci : order)
-        forColour(
-            colour(ci), o.pool,
-            [&](std::int32_t gi) { groupMomentum(p, p.groups[static_cast<size_t>(gi)], bodies, o.dynamic_end); },
-            [&](int b0, int b1) {
-              o.kernels->momentum(p.batches.data(), b0, b1, body_data, p.island_beta.data(), sp);
-            });
+      forColours(
+          p, flow, o.pool, order,
+          [&](std::int32_t gi) { groupMomentum(p, p.groups[static_cast<size_t>(gi)], bodies, o.dynamic_end); },
+          [&](int b0, int b1) { o.kernels->momentum(p.batches.data(), b0, b1, body_data, p.island_beta.data(), sp); });
     }
   }
   return stats;
@@ -427,13 +466,14 @@ void biasPass(GraphProblem& p, std::span<SolverBody> bodies, Correction which, b
   double* body_data = bodies.front().v.data();
   const ContactSweepParams sp = sweepParams(p, o, false);
   forParts(p, o, [&](int, const Part& part, const GraphSolveOptions& po) {
+    const bool flow = useFlow(p, po);
     for (int it = 0; it < po.iterations; ++it) {
-      for (std::int32_t ci = part.colour_begin; ci < part.colour_end; ++ci)
-        forColour(
-            p.colours[static_cast<size_t>(ci)], po.pool, [&](std::int32_t gi) { biasGroup(p, gi, bodies, which, po); },
-            [&](int b0, int b1) {
-              if (contacts) po.kernels->solve_bias(p.batches.data(), b0, b1, body_data, sp);
-            });
+      forColours(
+          p, flow, po.pool, std::views::iota(part.colour_begin, part.colour_end),
+          [&](std::int32_t gi) { biasGroup(p, gi, bodies, which, po); },
+          [&](int b0, int b1) {
+            if (contacts) po.kernels->solve_bias(p.batches.data(), b0, b1, body_data, sp);
+          });
       reduceSweep(p, part, contacts);
       if (!stopConverged(p, part, po, it + 1)) break;
     }

@@ -25,6 +25,7 @@
 #pragma once
 
 #include "constraints/row.hpp"
+#include "solver/colour_flow.hpp"
 #include "solver/contact_batch.hpp"
 #include "solver/contact_kernels.hpp"
 #include "solver/solver_body.hpp"
@@ -65,8 +66,9 @@ struct GraphProblem {
   // Parts solved side by side, each on one thread with no barrier between
   // its colours: part k is the colours [part_colour[k], part_colour[k + 1])
   // and the islands [part_island[k], part_island[k + 1]), and no constraint
-  // of one part touches an island of another. Empty: one part, every
-  // colour split among the threads instead (a scene of one large island).
+  // of one part touches an island of another. Empty: one part, whose
+  // colours the threads share instead (a scene of one large island: by the
+  // flow schedule below, or colour by colour).
   // An island's constraints are coloured the same either way, and islands
   // never share a sweep's result (each stops on its own, with its own
   // momentum), so the parts change nothing but which thread does the work.
@@ -81,6 +83,10 @@ struct GraphProblem {
   std::vector<int> island_iterations;
   std::vector<std::vector<std::int32_t>> part_order;  // per part: its sweep's colour order
   std::vector<GraphSolveStats> part_stats;
+  // One part with a pool: the colours' schedule without barriers
+  // (colour_flow.hpp), planned at the first pass over this problem.
+  ColourFlow flow;
+  bool flow_planned = false, flow_ready = false;
 
   void clear() {
     batches.clear();
@@ -90,6 +96,7 @@ struct GraphProblem {
     island_count = 0;
     part_colour.clear();
     part_island.clear();
+    flow_planned = flow_ready = false;
   }
   bool empty() const { return batches.empty() && groups.empty(); }
 };

@@ -17,6 +17,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 namespace cairn {
@@ -106,28 +107,59 @@ TEST(Determinism, IslandsSweptAsOnePartPerThreadAreBitIdentical) {
 // fill, the impulse store and the watchers hand their loops to the pool
 // (world/parallel_thresholds.hpp). A pyramid of base 60 (1,830 boxes,
 // about 5,400 touching manifolds) is past all four from its first step,
-// and is one island, whose colours (not parts) the threads split; the test
-// checks both before it compares 10 steps on 1, 2 and 4 threads.
+// and is one island, large enough that its colours are swept by the flow
+// schedule (solver/colour_flow.hpp: each thread its share of every colour,
+// waiting only for the other threads' items that touched its bodies last);
+// the test checks all of that, on two threads and on four, before it
+// compares 10 steps on 1, 2 and 4 threads.
 TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
   const SceneDesc s = scenarios::pyramid(60);
-  {
+  for (const int threads : {2, 4}) {
     SceneDesc threaded = s;
-    threaded.solver.threads = 2;
+    threaded.solver.threads = threads;
     World w = buildWorld(threaded);
     w.step(s.dt);
     const detail::WorldImpl& in = detail::internals(w);
-    const auto batches = static_cast<int>(in.stepContext().graph.batches.size());
+    const GraphProblem& g = in.stepContext().graph;
+    const auto batches = static_cast<int>(g.batches.size());
     ASSERT_GE(static_cast<int>(in.pairs_.size()), detail::kParallelPairs);
     ASSERT_GE(batches, detail::kParallelBatches);
     ASSERT_GE(batches * kBatchLanes, detail::kParallelLanes);
     ASSERT_GE(static_cast<int>(in.contacts().size()), detail::kParallelContacts);
-    // One island: no even split into parts, so its colours are what the
-    // threads share.
-    ASSERT_TRUE(in.stepContext().graph.part_colour.empty());
+    // One island: no even split into parts; its colours are what the
+    // threads share, by the flow schedule.
+    ASSERT_TRUE(g.part_colour.empty());
+    ASSERT_TRUE(g.flow_ready) << threads << " threads";
   }
   const auto one = run(s, 10, 1, Simd::Auto);
   expectIdentical(one, run(s, 10, 2, Simd::Auto));
   expectIdentical(one, run(s, 10, 4, Simd::Auto));
+}
+
+// A pyramid of base 30 (465 boxes, about 200 batches) is one island too
+// small for the flow schedule (solver/graph_solver.cpp, kFlowWork): its
+// colours are split among the threads one at a time, each ending at a
+// barrier, and its lowest colours hold the four batches or more past which
+// a colour is handed to the pool (kParallelWork). The test checks that
+// path was taken before it compares 20 steps on 1, 2 and 4 threads.
+TEST(Determinism, MidSizedPyramidSplitsEachColourAtABarrierAndIsBitIdentical) {
+  const SceneDesc s = scenarios::pyramid(30);
+  constexpr int kSplitColour = 4;  // graph_solver.cpp, kParallelWork
+  for (const int threads : {2, 4}) {
+    SceneDesc threaded = s;
+    threaded.solver.threads = threads;
+    World w = buildWorld(threaded);
+    w.step(s.dt);
+    const GraphProblem& g = detail::internals(w).stepContext().graph;
+    ASSERT_TRUE(g.part_colour.empty());
+    ASSERT_FALSE(g.flow_ready) << threads << " threads";
+    int widest = 0;
+    for (const GraphColour& c : g.colours) widest = std::max(widest, c.batch_end - c.batch_begin);
+    ASSERT_GE(widest, kSplitColour);
+  }
+  const auto one = run(s, 20, 1, Simd::Auto);
+  expectIdentical(one, run(s, 20, 2, Simd::Auto));
+  expectIdentical(one, run(s, 20, 4, Simd::Auto));
 }
 
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {

@@ -1,0 +1,127 @@
+// The colours of one large island swept by several threads with no barrier
+// between colours.
+//
+// A colour's constraints share no dynamic body, so threads can split each
+// colour and meet at a barrier after it (graph_solver.cpp, forColour). A
+// stack's level order makes many small colours instead: a pyramid's
+// colours hold one to a few batches each, and a barrier per colour costs
+// about what the second thread saves. Here each thread takes, in every
+// colour, one contiguous run of the colour's items, and before an item it
+// waits only for the items of other threads that last touched one of its
+// dynamic bodies: a dataflow schedule over the same order, in the manner
+// of the dependency graphs Jolt builds between its jobs (JobSystem.h),
+// here fixed per step and per body. Every body still sees its constraints
+// in colour order, one at a time, so a pass gives the same bits as one
+// thread's. No wait can deadlock: an item waits only for items of earlier
+// colours.
+//
+// The threads walk their runs toward each other: the first thread from
+// the start of its run, the last from the end. A colour's items are in the
+// order of their bodies (a stack's, left to right), so the items at the
+// border between two threads' runs come last in both, and the next
+// colour's border items, the ones that wait for the other thread, find
+// their predecessors done a colour earlier.
+//
+// The plan is made once per (sub)step for the graph built in it, and used
+// by every pass over the colours (warm start, sweeps, momentum, correction)
+// whose items touch the bodies the plan saw.
+#pragma once
+
+#include "solver/worker_pool.hpp"
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace cairn {
+
+struct GraphProblem;
+
+// Item `item` of colour `colour`: its row groups, then its batches
+// (graph_solver.cpp's item numbering).
+struct FlowItem {
+  std::int32_t colour = 0, item = 0;
+};
+
+class ColourFlow {
+ public:
+  ColourFlow() = default;
+  // A copy has the plan but counters of its own.
+  ColourFlow(const ColourFlow& o) { *this = o; }
+  ColourFlow& operator=(const ColourFlow& o);
+
+  // Plans the colours of `p` (one part, in order) for `threads` threads;
+  // solver bodies [1, dynamic_end) are the ones written. Returns whether
+  // the schedule pays: its critical path, in batch visits, at least
+  // `min_saving` visits shorter than one thread's pass. Else nothing is
+  // planned and the caller splits colour by colour.
+  bool plan(const GraphProblem& p, int threads, int dynamic_end, double min_saving);
+
+  // Runs fn(item) for every item on `pool` (whose thread count the plan
+  // was made for): each thread its own items, each after the other
+  // threads' items it waits for.
+  template <class F>
+  void run(WorkerPool& pool, F&& fn) {
+    for (int t = 0; t < threads_; ++t) progress_[t].done.store(0, std::memory_order_relaxed);
+    pool.parallelFor(threads_, [&](int t, int) { runThread(t, fn); });
+  }
+
+ private:
+  struct alignas(64) Progress {
+    std::atomic<std::int32_t> done{0};  // items of this thread finished in this pass
+  };
+
+  template <class F>
+  void runThread(int t, F& fn) {
+    const std::int32_t first = thread_begin_[static_cast<size_t>(t)];
+    const std::int32_t last = thread_begin_[static_cast<size_t>(t) + 1];
+    for (std::int32_t k = first; k < last; ++k) {
+      const std::int32_t* need = need_.data() + static_cast<size_t>(k) * static_cast<size_t>(threads_);
+      for (int u = 0; u < threads_; ++u)
+        if (need[u] > 0) waitFor(u, need[u]);
+      fn(items_[static_cast<size_t>(k)]);
+      progress_[t].done.store(k - first + 1, std::memory_order_release);
+    }
+  }
+  void waitFor(int thread, std::int32_t items) const;
+
+  int threads_ = 0;
+  std::vector<std::int32_t> thread_begin_;  // thread t's items: [thread_begin_[t], thread_begin_[t + 1])
+  std::vector<FlowItem> items_;             // by thread, each thread's in the order it visits them
+  std::vector<std::int32_t> need_;          // per item and thread u: items of u to wait for
+  std::unique_ptr<Progress[]> progress_;
+  int progress_size_ = 0;
+
+  // Planning, with scratch kept so that it allocates nothing once warm.
+  struct Planned {
+    FlowItem item;
+    std::int32_t thread = 0, at = 0;  // its thread, and its place in that thread's visits
+    std::int64_t finish = 0;          // when it ends in the plan's model of a pass
+  };
+  struct Run {
+    std::int32_t thread = 0, begin = 0, end = 0;
+  };
+  void colourItems(const GraphProblem& p, std::int32_t colour, int dynamic_end);
+  std::span<const std::int32_t> bodiesOf(std::int32_t item) const {
+    const std::int32_t begin = item_body_begin_[static_cast<size_t>(item)];
+    return {item_bodies_.data() + begin, static_cast<size_t>(item_body_begin_[static_cast<size_t>(item) + 1] - begin)};
+  }
+  std::int64_t ready(std::int32_t item, std::int32_t thread) const;
+  std::int64_t evaluate(const std::vector<Run>& runs, std::int64_t& sum) const;
+  void commit(std::int32_t colour, const std::vector<Run>& runs);
+  bool backward(std::int32_t thread) const { return thread > 0 && thread == threads_ - 1; }
+
+  std::vector<Planned> sequence_;              // every item, in the order planned
+  std::vector<std::int32_t> need_sequence_;    // need_, in that order
+  std::vector<std::int32_t> count_;            // per thread: items so far
+  std::vector<std::int64_t> load_, free_;      // per thread: work so far, and when it is free
+  std::vector<std::int32_t> last_;             // per body: the last item (in sequence_) to touch it
+  std::vector<std::int32_t> item_work_;        // the colour's items: work in eighths of a batch visit,
+  std::vector<std::int32_t> item_body_begin_;  // and dynamic bodies
+  std::vector<std::int32_t> item_bodies_;
+  std::vector<Run> runs_, best_;
+};
+
+}  // namespace cairn

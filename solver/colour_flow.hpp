@@ -16,11 +16,13 @@
 // colours.
 //
 // The threads walk their runs toward each other: the first thread from
-// the start of its run, the last from the end. A colour's items are in the
-// order of their bodies (a stack's, left to right), so the items at the
+// the start of its run, the last from the end. A colour's items come in
+// the order their constraints were made, which for a stack built row by
+// row is the order of its bodies, left to right; then the items at the
 // border between two threads' runs come last in both, and the next
 // colour's border items, the ones that wait for the other thread, find
-// their predecessors done a colour earlier.
+// their predecessors done a colour earlier. In any other order the
+// schedule is as correct, only slower.
 //
 // The plan is made once per (sub)step for the graph built in it, and used
 // by every pass over the colours (warm start, sweeps, momentum, correction)

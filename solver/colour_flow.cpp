@@ -3,15 +3,14 @@
 #include "solver/graph_solver.hpp"
 
 #include <algorithm>
-#include <thread>
 
 namespace cairn {
 
 namespace {
 
-// Work in eighths of a batch visit: a joint's row group is about an eighth
-// of a batch (graph_solver.cpp, kGroupWork).
-constexpr std::int32_t kBatchWork = 8;
+// Work in row groups: a batch visit costs about kGroupsPerBatchVisit of
+// them (graph_solver.hpp).
+constexpr std::int32_t kBatchWork = kGroupsPerBatchVisit;
 constexpr std::int32_t kGroupWork = 1;
 
 // What an item that waits for another thread's item loses, in the plan's
@@ -33,21 +32,12 @@ constexpr std::int32_t kHandover = kBatchWork;
 // colour is better split.
 constexpr std::int32_t kMaxWhole = 1;
 
-// As the pool's own waits (worker_pool.cpp): spin, then yield the core to
-// the thread waited for when the machine has none to spare.
-constexpr int kSpins = 256;
-
-inline void pause() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#endif
-}
-
 }  // namespace
 
 ColourFlow& ColourFlow::operator=(const ColourFlow& o) {
   if (this == &o) return *this;
   threads_ = o.threads_;
+  planned_ = o.planned_;
   thread_begin_ = o.thread_begin_;
   items_ = o.items_;
   need_ = o.need_;
@@ -58,10 +48,7 @@ ColourFlow& ColourFlow::operator=(const ColourFlow& o) {
 
 void ColourFlow::waitFor(int thread, std::int32_t items) const {
   const std::atomic<std::int32_t>& done = progress_[thread].done;
-  for (int spin = 0; done.load(std::memory_order_acquire) < items; ++spin) {
-    if (spin < kSpins) pause();
-    else std::this_thread::yield();
-  }
+  for (int spin = 0; done.load(std::memory_order_acquire) < items; ++spin) WorkerPool::waitRound(spin);
 }
 
 // The work and dynamic bodies of each item of a colour (its row groups,
@@ -116,7 +103,7 @@ std::int64_t ColourFlow::evaluate(const std::vector<Run>& runs, std::int64_t& su
   for (const Run& r : runs) {
     std::int64_t t = free_[static_cast<size_t>(r.thread)];
     for (std::int32_t n = 0; n < r.end - r.begin; ++n) {
-      const std::int32_t i = backward(r.thread) ? r.end - 1 - n : r.begin + n;
+      const std::int32_t i = visit(r, n);
       t = std::max(t, ready(i, r.thread)) + item_work_[static_cast<size_t>(i)];
     }
     end = std::max(end, t);
@@ -131,7 +118,7 @@ void ColourFlow::commit(std::int32_t colour, const std::vector<Run>& runs) {
   for (const Run& r : runs) {
     const size_t t = static_cast<size_t>(r.thread);
     for (std::int32_t n = 0; n < r.end - r.begin; ++n) {
-      const std::int32_t i = backward(r.thread) ? r.end - 1 - n : r.begin + n;
+      const std::int32_t i = visit(r, n);
       Planned s;
       s.item = {colour, i};
       s.thread = r.thread;
@@ -163,6 +150,7 @@ void ColourFlow::commit(std::int32_t colour, const std::vector<Run>& runs) {
 
 bool ColourFlow::plan(const GraphProblem& p, int threads, int dynamic_end, double min_saving) {
   threads_ = 0;
+  planned_ = true;
   if (threads < 2 || p.colours.empty()) return false;
   threads_ = threads;
   const size_t T = static_cast<size_t>(threads);

@@ -60,6 +60,14 @@ class ColourFlow {
   // `min_saving` visits shorter than one thread's pass. Else nothing is
   // planned and the caller splits colour by colour.
   bool plan(const GraphProblem& p, int threads, int dynamic_end, double min_saving);
+  // Whether plan() has run since the last reset(), and whether it made a
+  // schedule to run.
+  bool planned() const { return planned_; }
+  bool ready() const { return threads_ > 0; }
+  void reset() {
+    threads_ = 0;
+    planned_ = false;
+  }
 
   // Runs fn(item) for every item on `pool` (whose thread count the plan
   // was made for): each thread its own items, each after the other
@@ -89,7 +97,8 @@ class ColourFlow {
   }
   void waitFor(int thread, std::int32_t items) const;
 
-  int threads_ = 0;
+  int threads_ = 0;  // 0: no schedule
+  bool planned_ = false;
   std::vector<std::int32_t> thread_begin_;  // thread t's items: [thread_begin_[t], thread_begin_[t + 1])
   std::vector<FlowItem> items_;             // by thread, each thread's in the order it visits them
   std::vector<std::int32_t> need_;          // per item and thread u: items of u to wait for
@@ -113,7 +122,11 @@ class ColourFlow {
   std::int64_t ready(std::int32_t item, std::int32_t thread) const;
   std::int64_t evaluate(const std::vector<Run>& runs, std::int64_t& sum) const;
   void commit(std::int32_t colour, const std::vector<Run>& runs);
-  bool backward(std::int32_t thread) const { return thread > 0 && thread == threads_ - 1; }
+  // The n-th item a run's thread visits: the last thread walks its runs
+  // from the end.
+  std::int32_t visit(const Run& r, std::int32_t n) const {
+    return r.thread > 0 && r.thread == threads_ - 1 ? r.end - 1 - n : r.begin + n;
+  }
 
   std::vector<Planned> sequence_;              // every item, in the order planned
   std::vector<std::int32_t> need_sequence_;    // need_, in that order

@@ -112,7 +112,7 @@ void groupMomentum(GraphProblem& p, const RowGroup& g, std::span<SolverBody> bod
 // handover starts to pay. Work is counted in batch visits; a joint's row
 // group is about an eighth of one.
 constexpr double kParallelWork = 4;
-constexpr double kGroupWork = 1.0 / 8;
+constexpr double kGroupWork = 1.0 / kGroupsPerBatchVisit;
 
 // Below this much work a pass (in batch visits), the flow schedule
 // (colour_flow.hpp) is not planned. Planning costs about a batch visit per
@@ -229,11 +229,8 @@ bool useFlow(GraphProblem& p, const GraphSolveOptions& o) {
   if (!o.pool || o.randomize_order || partCount(p, o) != 1) return false;
   const double work = static_cast<double>(p.batches.size()) + kGroupWork * static_cast<double>(p.groups.size());
   if (work < kFlowWork) return false;
-  if (!p.flow_planned) {
-    p.flow_planned = true;
-    p.flow_ready = p.flow.plan(p, o.pool->threads(), o.dynamic_end, kParallelWork);
-  }
-  return p.flow_ready;
+  if (!p.flow.planned()) p.flow.plan(p, o.pool->threads(), o.dynamic_end, kParallelWork);
+  return p.flow.ready();
 }
 
 // One pass over `colours` in turn: by the flow schedule (`flow`: then the

@@ -45,6 +45,11 @@ struct RowGroup {
   std::int32_t island = 0;
 };
 
+// A joint's row group costs about 1 / kGroupsPerBatchVisit of a batch visit:
+// the work the thresholds and the flow plan count (graph_solver.cpp,
+// colour_flow.cpp).
+inline constexpr int kGroupsPerBatchVisit = 8;
+
 struct GraphSolveStats {
   int iterations = 0;       // the most sweeps any island took
   Real last_max_delta = 0;  // the largest impulse change of the islands' last sweeps
@@ -86,7 +91,6 @@ struct GraphProblem {
   // One part with a pool: the colours' schedule without barriers
   // (colour_flow.hpp), planned at the first pass over this problem.
   ColourFlow flow;
-  bool flow_planned = false, flow_ready = false;
 
   void clear() {
     batches.clear();
@@ -96,7 +100,7 @@ struct GraphProblem {
     island_count = 0;
     part_colour.clear();
     part_island.clear();
-    flow_planned = flow_ready = false;
+    flow.reset();
   }
   bool empty() const { return batches.empty() && groups.empty(); }
 };

@@ -13,12 +13,17 @@ thread_local int t_thread_index = 0;
 constexpr int kSpins = 256;
 constexpr int kYields = 64;
 
-inline void pause() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#endif
-}
 }  // namespace
+
+void WorkerPool::waitRound(int spin) {
+  if (spin < kSpins) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  } else {
+    std::this_thread::yield();
+  }
+}
 
 WorkerPool::WorkerPool(int threads) : threads_(threads < 1 ? 1 : threads) {
   workers_.reserve(static_cast<size_t>(threads_ - 1));
@@ -57,10 +62,7 @@ void WorkerPool::run(const Job& job) {
   }
   wake_.notify_all();
   doChunk(job_, 0);
-  for (int spin = 0; remaining_.load(std::memory_order_acquire) != 0; ++spin) {
-    if (spin < kSpins) pause();
-    else std::this_thread::yield();
-  }
+  for (int spin = 0; remaining_.load(std::memory_order_acquire) != 0; ++spin) waitRound(spin);
 }
 
 void WorkerPool::workerLoop(int index) {
@@ -71,8 +73,7 @@ void WorkerPool::workerLoop(int index) {
   for (;;) {
     std::uint64_t now = generation_.load(std::memory_order_acquire);
     for (int spin = 0; now == seen && spin < kSpins + kYields; ++spin) {
-      if (spin < kSpins) pause();
-      else std::this_thread::yield();
+      waitRound(spin);
       now = generation_.load(std::memory_order_acquire);
     }
     if (now == seen) {

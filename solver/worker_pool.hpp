@@ -36,6 +36,11 @@ class WorkerPool {
   // 0 on the thread that calls parallelFor, 1 .. threads - 1 on the workers.
   static int currentThread();
 
+  // Round `spin` (from 0) of a wait for another thread: a pause for the
+  // first rounds, then a yield of the core, so that on a machine with no
+  // core to spare the thread waited for can run.
+  static void waitRound(int spin);
+
   // Calls fn(begin, end) on contiguous chunks of [0, count), one per thread
   // (fewer when count is small), and returns when all are done. Not
   // re-entrant: fn must not call parallelFor.

@@ -129,7 +129,7 @@ TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
     // One island: no even split into parts; its colours are what the
     // threads share, by the flow schedule.
     ASSERT_TRUE(g.part_colour.empty());
-    ASSERT_TRUE(g.flow_ready) << threads << " threads";
+    ASSERT_TRUE(g.flow.ready()) << threads << " threads";
   }
   const auto one = run(s, 10, 1, Simd::Auto);
   expectIdentical(one, run(s, 10, 2, Simd::Auto));
@@ -152,7 +152,7 @@ TEST(Determinism, MidSizedPyramidSplitsEachColourAtABarrierAndIsBitIdentical) {
     w.step(s.dt);
     const GraphProblem& g = detail::internals(w).stepContext().graph;
     ASSERT_TRUE(g.part_colour.empty());
-    ASSERT_FALSE(g.flow_ready) << threads << " threads";
+    ASSERT_FALSE(g.flow.ready()) << threads << " threads";
     int widest = 0;
     for (const GraphColour& c : g.colours) widest = std::max(widest, c.batch_end - c.batch_begin);
     ASSERT_GE(widest, kSplitColour);

@@ -46,37 +46,37 @@ ColourFlow& ColourFlow::operator=(const ColourFlow& o) {
   return *this;
 }
 
-void ColourFlow::waitFor(int thread, std::int32_t items) const {
-  const std::atomic<std::int32_t>& done = progress_[thread].done;
-  for (int spin = 0; done.load(std::memory_order_acquire) < items; ++spin) WorkerPool::waitRound(spin);
+void appendItemBodies(const GraphProblem& p, FlowItem it, int dynamic_end, std::vector<std::int32_t>& out) {
+  const auto dynamic = [&](std::int32_t b) { return b > 0 && b < dynamic_end; };
+  const GraphColour& gc = p.colours[static_cast<size_t>(it.colour)];
+  const std::int32_t groups = gc.group_end - gc.group_begin;
+  if (it.item < groups) {
+    const RowGroup& g = p.groups[static_cast<size_t>(gc.group_begin + it.item)];
+    for (std::int32_t r = g.begin; r < g.end; ++r) {
+      const ConstraintRow& row = p.rows[static_cast<size_t>(r)];
+      if (dynamic(row.body_a)) out.push_back(row.body_a);
+      if (dynamic(row.body_b)) out.push_back(row.body_b);
+    }
+    return;
+  }
+  const ContactBatch& b = p.batches[static_cast<size_t>(gc.batch_begin + it.item - groups)];
+  for (int l = 0; l < kBatchLanes; ++l) {
+    if (b.count[l] == 0) continue;
+    if (dynamic(b.body_a[l])) out.push_back(b.body_a[l]);
+    if (dynamic(b.body_b[l])) out.push_back(b.body_b[l]);
+  }
 }
 
-// The work and dynamic bodies of each item of a colour (its row groups,
-// then its batches' lanes in use).
+// The work and dynamic bodies of each item of a colour.
 void ColourFlow::colourItems(const GraphProblem& p, std::int32_t colour, int dynamic_end) {
-  const auto dynamic = [&](std::int32_t b) { return b > 0 && b < dynamic_end; };
   const GraphColour& gc = p.colours[static_cast<size_t>(colour)];
+  const std::int32_t groups = gc.group_end - gc.group_begin;
   item_work_.clear();
   item_body_begin_.assign(1, 0);
   item_bodies_.clear();
-  for (std::int32_t gi = gc.group_begin; gi < gc.group_end; ++gi) {
-    const RowGroup& g = p.groups[static_cast<size_t>(gi)];
-    for (std::int32_t r = g.begin; r < g.end; ++r) {
-      const ConstraintRow& row = p.rows[static_cast<size_t>(r)];
-      if (dynamic(row.body_a)) item_bodies_.push_back(row.body_a);
-      if (dynamic(row.body_b)) item_bodies_.push_back(row.body_b);
-    }
-    item_work_.push_back(kGroupWork);
-    item_body_begin_.push_back(static_cast<std::int32_t>(item_bodies_.size()));
-  }
-  for (std::int32_t bi = gc.batch_begin; bi < gc.batch_end; ++bi) {
-    const ContactBatch& b = p.batches[static_cast<size_t>(bi)];
-    for (int l = 0; l < kBatchLanes; ++l) {
-      if (b.count[l] == 0) continue;
-      if (dynamic(b.body_a[l])) item_bodies_.push_back(b.body_a[l]);
-      if (dynamic(b.body_b[l])) item_bodies_.push_back(b.body_b[l]);
-    }
-    item_work_.push_back(kBatchWork);
+  for (std::int32_t i = 0; i < groups + gc.batch_end - gc.batch_begin; ++i) {
+    appendItemBodies(p, {colour, i}, dynamic_end, item_bodies_);
+    item_work_.push_back(i < groups ? kGroupWork : kBatchWork);
     item_body_begin_.push_back(static_cast<std::int32_t>(item_bodies_.size()));
   }
 }

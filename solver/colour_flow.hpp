@@ -47,6 +47,11 @@ struct FlowItem {
   std::int32_t colour = 0, item = 0;
 };
 
+// Appends to `out` the dynamic bodies (solver bodies [1, dynamic_end)) that
+// item `it` writes: its row group's rows' bodies, or its batch's lanes' in
+// use.
+void appendItemBodies(const GraphProblem& p, FlowItem it, int dynamic_end, std::vector<std::int32_t>& out);
+
 class ColourFlow {
  public:
   ColourFlow() = default;
@@ -90,12 +95,11 @@ class ColourFlow {
     for (std::int32_t k = first; k < last; ++k) {
       const std::int32_t* need = need_.data() + static_cast<size_t>(k) * static_cast<size_t>(threads_);
       for (int u = 0; u < threads_; ++u)
-        if (need[u] > 0) waitFor(u, need[u]);
+        if (need[u] > 0) WorkerPool::waitAtLeast(progress_[u].done, need[u]);
       fn(items_[static_cast<size_t>(k)]);
       progress_[t].done.store(k - first + 1, std::memory_order_release);
     }
   }
-  void waitFor(int thread, std::int32_t items) const;
 
   int threads_ = 0;  // 0: no schedule
   bool planned_ = false;

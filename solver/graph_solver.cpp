@@ -124,6 +124,19 @@ constexpr double kGroupWork = 1.0 / kGroupsPerBatchVisit;
 // (docs/performance.md).
 constexpr double kFlowWork = 256;
 
+// Below this many manifold batches, consecutive passes are not run side by
+// side (pass_pipeline.hpp). The trailing pass reads what the leading one
+// has just written on the other core (the bodies, the batch's impulses),
+// which made each of its batch visits about 1.6 times as long on the 2-core
+// Xeon of docs/performance.md; it pays only where a pass trails the one
+// before by a small share of its items. Measured, two threads against the
+// barrier per colour: pyramid-10's 39 batches (trailing by 8) solved a
+// quarter slower, pyramid-20's 111 (by 14) 8% faster, pyramid-30's 222 (by
+// 17) 1.3 times faster; chain-100's joints alone (100 row groups, each an
+// eighth of a batch visit) solved 15 to 40% slower, so row groups do not
+// count.
+constexpr int kPipelineBatches = 96;
+
 // Runs fn(begin, end) over [0, count), on the pool's threads if there is one
 // and the loop's `work` (in batch visits) pays for it.
 template <class F>
@@ -146,7 +159,7 @@ ContactSweepParams sweepParams(const GraphProblem& p, const GraphSolveOptions& o
 // The items [begin, end) of a colour, which numbers its row groups, then
 // its manifold batches.
 template <class Groups, class Batches>
-void forItems(const GraphColour& c, int begin, int end, Groups& groups_fn, Batches& batches_fn) {
+void forItems(const GraphColour& c, int begin, int end, Groups&& groups_fn, Batches&& batches_fn) {
   const int groups = c.group_end - c.group_begin;
   for (int i = begin; i < std::min(end, groups); ++i) groups_fn(c.group_begin + i);
   const int b0 = std::max(begin, groups) - groups, b1 = end - groups;
@@ -334,6 +347,20 @@ void startSweeps(GraphProblem& p) {
   p.group_lambda.assign(p.groups.size(), Real(0));
 }
 
+// The passes of a sweep over a part's constraints.
+enum class Pass { WarmStart, Normals, Friction, Momentum };
+
+// Whether the passes of this problem run side by side (pass_pipeline.hpp):
+// one part in colour order with a pool, no flow schedule (which shares each
+// pass's colours instead, and is chosen past its own, larger size), and
+// enough batches.
+bool usePipeline(GraphProblem& p, const GraphSolveOptions& o, bool flow) {
+  if (!o.pool || flow || o.randomize_order || partCount(p, o) != 1) return false;
+  if (static_cast<int>(p.batches.size()) < kPipelineBatches) return false;
+  if (!p.pipeline.planned()) p.pipeline.plan(p, o.dynamic_end);
+  return true;
+}
+
 // Warm start and the velocity sweeps of one part. `order` is this part's
 // own colour order (parts never randomize: the step makes none then).
 GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::int32_t>& order,
@@ -341,31 +368,72 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
   GraphSolveStats stats;
   double* body_data = bodies.front().v.data();
   const bool flow = useFlow(p, o);
-
-  // Warm start: the carried impulses act before the first sweep.
+  const bool pipeline = usePipeline(p, o, flow);
   const ContactSweepParams warm = sweepParams(p, o, false);
-  forColours(
-      p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end),
-      [&](std::int32_t gi) {
-        const RowGroup& g = p.groups[static_cast<size_t>(gi)];
-        for (std::int32_t k = g.begin; k < g.end; ++k) {
-          const ConstraintRow& r = p.rows[static_cast<size_t>(k)];
-          if (r.lambda != 0) applyRow(r, bodies, o.dynamic_end, r.lambda);
-        }
-      },
-      [&](int b0, int b1) { o.kernels->warm_start(p.batches.data(), b0, b1, body_data, warm); });
-
   const ContactSweepParams sp = sweepParams(p, o, o.nncg);
+
+  const auto groupFn = [&](Pass pass) {
+    return [&, pass](std::int32_t gi) {
+      switch (pass) {
+        case Pass::WarmStart: {  // the carried impulses act before the first sweep
+          const RowGroup& g = p.groups[static_cast<size_t>(gi)];
+          for (std::int32_t k = g.begin; k < g.end; ++k) {
+            const ConstraintRow& r = p.rows[static_cast<size_t>(k)];
+            if (r.lambda != 0) applyRow(r, bodies, o.dynamic_end, r.lambda);
+          }
+          break;
+        }
+        case Pass::Normals: solveGroup(p, gi, bodies, o, o.nncg); break;
+        case Pass::Friction: break;  // a group's friction rows go with its normal rows
+        case Pass::Momentum: groupMomentum(p, p.groups[static_cast<size_t>(gi)], bodies, o.dynamic_end); break;
+      }
+    };
+  };
+  const auto batchFn = [&](Pass pass) {
+    return [&, pass](int b0, int b1) {
+      switch (pass) {
+        case Pass::WarmStart: o.kernels->warm_start(p.batches.data(), b0, b1, body_data, warm); break;
+        case Pass::Normals: o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, sp); break;
+        case Pass::Friction: o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); break;
+        case Pass::Momentum:
+          o.kernels->momentum(p.batches.data(), b0, b1, body_data, p.island_beta.data(), sp);
+          break;
+      }
+    };
+  };
+  // The passes queued since the last sweep's end, run in turn (the warm
+  // start in storage order, the others in this sweep's colour order) or,
+  // with the pipeline, side by side. Without it each pass runs as soon as
+  // it is queued, so a shuffled order (randomize_order) is the one of its
+  // own sweep.
+  Pass passes[PassPipeline::kMaxPasses];
+  int pending = 0;
+  const auto runPasses = [&] {
+    if (pipeline) {
+      p.pipeline.run(*o.pool, pending, [&](int j, const FlowItem& it) {
+        forItems(p.colours[static_cast<size_t>(it.colour)], it.item, it.item + 1, groupFn(passes[j]),
+                 batchFn(passes[j]));
+      });
+    } else {
+      for (int j = 0; j < pending; ++j) {
+        if (passes[j] == Pass::WarmStart)
+          forColours(p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end), groupFn(passes[j]),
+                     batchFn(passes[j]));
+        else
+          forColours(p, flow, o.pool, order, groupFn(passes[j]), batchFn(passes[j]));
+      }
+    }
+    pending = 0;
+  };
+
+  passes[pending++] = Pass::WarmStart;
+  if (!pipeline) runPasses();
   const bool batches = part.batch_end > part.batch_begin;
   for (int it = 0; it < o.iterations; ++it) {
     if (o.randomize_order || it == 0) orderColours(order, part, o.randomize_order, rng_state);
-    forColours(
-        p, flow, o.pool, order, [&](std::int32_t gi) { solveGroup(p, gi, bodies, o, o.nncg); },
-        [&](int b0, int b1) { o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, sp); });
-    if (batches)  // a jointed scene without contacts has no friction pass to walk
-      forColours(
-          p, flow, o.pool, order, [](std::int32_t) {},
-          [&](int b0, int b1) { o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); });
+    passes[pending++] = Pass::Normals;
+    if (batches) passes[pending++] = Pass::Friction;  // a jointed scene without contacts has no friction pass
+    runPasses();
     reduceSweep(p, part, true);
     stats.last_max_delta = 0;
     for (std::int32_t i = part.island_begin; i < part.island_end; ++i)
@@ -376,10 +444,8 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
     // No momentum after the last sweep: the result must be a PGS iterate.
     if (o.nncg && it + 1 < o.iterations) {
       islandBetas(p, part);
-      forColours(
-          p, flow, o.pool, order,
-          [&](std::int32_t gi) { groupMomentum(p, p.groups[static_cast<size_t>(gi)], bodies, o.dynamic_end); },
-          [&](int b0, int b1) { o.kernels->momentum(p.batches.data(), b0, b1, body_data, p.island_beta.data(), sp); });
+      passes[pending++] = Pass::Momentum;
+      if (!pipeline) runPasses();
     }
   }
   return stats;

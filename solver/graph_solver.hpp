@@ -28,6 +28,7 @@
 #include "solver/colour_flow.hpp"
 #include "solver/contact_batch.hpp"
 #include "solver/contact_kernels.hpp"
+#include "solver/pass_pipeline.hpp"
 #include "solver/solver_body.hpp"
 
 #include <cstdint>
@@ -91,6 +92,9 @@ struct GraphProblem {
   // One part with a pool: the colours' schedule without barriers
   // (colour_flow.hpp), planned at the first pass over this problem.
   ColourFlow flow;
+  // One part with a pool and no flow schedule: consecutive passes side by
+  // side (pass_pipeline.hpp), planned at the first sweep.
+  PassPipeline pipeline;
 
   void clear() {
     batches.clear();
@@ -101,6 +105,7 @@ struct GraphProblem {
     part_colour.clear();
     part_island.clear();
     flow.reset();
+    pipeline.reset();
   }
   bool empty() const { return batches.empty() && groups.empty(); }
 };

@@ -25,6 +25,15 @@ void WorkerPool::waitRound(int spin) {
   }
 }
 
+std::int32_t WorkerPool::waitAtLeast(const std::atomic<std::int32_t>& counter, std::int32_t value) {
+  std::int32_t now = counter.load(std::memory_order_acquire);
+  for (int spin = 0; now < value; ++spin) {
+    waitRound(spin);
+    now = counter.load(std::memory_order_acquire);
+  }
+  return now;
+}
+
 WorkerPool::WorkerPool(int threads) : threads_(threads < 1 ? 1 : threads) {
   workers_.reserve(static_cast<size_t>(threads_ - 1));
   for (int i = 1; i < threads_; ++i) workers_.emplace_back([this, i] { workerLoop(i); });

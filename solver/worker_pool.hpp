@@ -40,6 +40,9 @@ class WorkerPool {
   // first rounds, then a yield of the core, so that on a machine with no
   // core to spare the thread waited for can run.
   static void waitRound(int spin);
+  // Waits, round after round, until `counter` (read with acquire order)
+  // holds at least `value`; returns the last value read.
+  static std::int32_t waitAtLeast(const std::atomic<std::int32_t>& counter, std::int32_t value);
 
   // Calls fn(begin, end) on contiguous chunks of [0, count), one per thread
   // (fewer when count is small), and returns when all are done. Not

@@ -136,13 +136,17 @@ TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
   expectIdentical(one, run(s, 10, 4, Simd::Auto));
 }
 
-// A pyramid of base 30 (465 boxes, about 200 batches) is one island too
-// small for the flow schedule (solver/graph_solver.cpp, kFlowWork): its
-// colours are split among the threads one at a time, each ending at a
-// barrier, and its lowest colours hold the four batches or more past which
-// a colour is handed to the pool (kParallelWork). The test checks that
-// path was taken before it compares 20 steps on 1, 2 and 4 threads.
-TEST(Determinism, MidSizedPyramidSplitsEachColourAtABarrierAndIsBitIdentical) {
+// A pyramid of base 30 (465 boxes, about 220 batches) is one island too
+// small for the flow schedule (solver/graph_solver.cpp, kFlowWork) and
+// large enough (kPipelineBatches) that the passes of a sweep run side by
+// side: the friction pass on one thread a few constraints behind the
+// normal pass on the other (solver/pass_pipeline.hpp). Its lowest colours
+// hold the four batches or more past which a colour of a single pass (the
+// correction passes, restitution) is split among the threads at a barrier
+// (kParallelWork); with randomize_order the sweeps take that path too. The
+// test checks the paths were taken, on two threads and on four, then
+// compares 20 steps on 1, 2 and 4 threads, in colour order and shuffled.
+TEST(Determinism, MidSizedPyramidRunsItsPassesSideBySideAndIsBitIdentical) {
   const SceneDesc s = scenarios::pyramid(30);
   constexpr int kSplitColour = 4;  // graph_solver.cpp, kParallelWork
   for (const int threads : {2, 4}) {
@@ -153,13 +157,18 @@ TEST(Determinism, MidSizedPyramidSplitsEachColourAtABarrierAndIsBitIdentical) {
     const GraphProblem& g = detail::internals(w).stepContext().graph;
     ASSERT_TRUE(g.part_colour.empty());
     ASSERT_FALSE(g.flow.ready()) << threads << " threads";
+    ASSERT_TRUE(g.pipeline.planned()) << threads << " threads";
     int widest = 0;
     for (const GraphColour& c : g.colours) widest = std::max(widest, c.batch_end - c.batch_begin);
     ASSERT_GE(widest, kSplitColour);
   }
-  const auto one = run(s, 20, 1, Simd::Auto);
-  expectIdentical(one, run(s, 20, 2, Simd::Auto));
-  expectIdentical(one, run(s, 20, 4, Simd::Auto));
+  SceneDesc shuffled = s;
+  shuffled.solver.randomize_order = true;
+  for (const SceneDesc& scene : {s, shuffled}) {
+    const auto one = run(scene, 20, 1, Simd::Auto);
+    expectIdentical(one, run(scene, 20, 2, Simd::Auto));
+    expectIdentical(one, run(scene, 20, 4, Simd::Auto));
+  }
 }
 
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {

@@ -74,7 +74,8 @@ struct GraphProblem {
   // and the islands [part_island[k], part_island[k + 1]), and no constraint
   // of one part touches an island of another. Empty: one part, whose
   // colours the threads share instead (a scene of one large island: by the
-  // flow schedule below, or colour by colour).
+  // flow schedule below, pass by pass with the pipeline below, or colour by
+  // colour).
   // An island's constraints are coloured the same either way, and islands
   // never share a sweep's result (each stops on its own, with its own
   // momentum), so the parts change nothing but which thread does the work.

@@ -7,8 +7,8 @@
 // all of its constraints done (the per-island stopping test and NNCG's
 // beta sum over the whole sweep). Between those points, pass j + 1's
 // constraint i needs of pass j only the constraints that last touched its
-// own dynamic bodies, which in a pyramid's level order or along a chain
-// come a level or a link ahead of i. So pass j + 1 can run on another
+// own dynamic bodies, which in a pyramid's level order come a level ahead
+// of i. So pass j + 1 can run on another
 // thread, trailing pass j by about that much: a wavefront (software
 // pipeline) over Gauss-Seidel passes, instead of splitting each pass's
 // colours, which a small island's colours of one to three batches cannot
@@ -17,6 +17,10 @@
 // j waits only for pass j - 1, which waits for nothing later.
 //
 // Pass j runs on thread j % threads; a thread runs its passes in order.
+// What it costs: the trailing pass reads the bodies and impulses the
+// leading one has just written on another core, so it pays only where a
+// pass trails by a small share of its items (graph_solver.cpp,
+// kPipelineBatches; docs/performance.md).
 #pragma once
 
 #include "solver/colour_flow.hpp"
@@ -34,7 +38,8 @@ struct GraphProblem;
 
 class PassPipeline {
  public:
-  // The most passes one run takes: momentum, normal rows, friction rows.
+  // The most passes one run takes: the warm start or momentum, then the
+  // normal rows and the friction rows.
   static constexpr int kMaxPasses = 3;
 
   PassPipeline() : progress_(std::make_unique<Progress[]>(kMaxPasses)) {}

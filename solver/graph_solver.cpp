@@ -401,39 +401,37 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
       }
     };
   };
-  // The passes queued since the last sweep's end, run in turn (the warm
-  // start in storage order, the others in this sweep's colour order) or,
-  // with the pipeline, side by side. Without it each pass runs as soon as
-  // it is queued, so a shuffled order (randomize_order) is the one of its
-  // own sweep.
+  // Without the pipeline a pass runs as soon as it is queued (the warm
+  // start in storage order, the others in this sweep's colour order, so a
+  // shuffled order is the one of its own sweep); with it, the passes queued
+  // since the last sweep's end run side by side at the next.
   Pass passes[PassPipeline::kMaxPasses];
   int pending = 0;
-  const auto runPasses = [&] {
+  const auto queue = [&](Pass pass) {
     if (pipeline) {
-      p.pipeline.run(*o.pool, pending, [&](int j, const FlowItem& it) {
-        forItems(p.colours[static_cast<size_t>(it.colour)], it.item, it.item + 1, groupFn(passes[j]),
-                 batchFn(passes[j]));
-      });
+      passes[pending++] = pass;
+    } else if (pass == Pass::WarmStart) {
+      forColours(p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end), groupFn(pass), batchFn(pass));
     } else {
-      for (int j = 0; j < pending; ++j) {
-        if (passes[j] == Pass::WarmStart)
-          forColours(p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end), groupFn(passes[j]),
-                     batchFn(passes[j]));
-        else
-          forColours(p, flow, o.pool, order, groupFn(passes[j]), batchFn(passes[j]));
-      }
+      forColours(p, flow, o.pool, order, groupFn(pass), batchFn(pass));
     }
+  };
+  const auto endSweep = [&] {
+    if (pending == 0) return;
+    p.pipeline.run(*o.pool, pending, [&](int j, const FlowItem& it) {
+      forItems(p.colours[static_cast<size_t>(it.colour)], it.item, it.item + 1, groupFn(passes[j]),
+               batchFn(passes[j]));
+    });
     pending = 0;
   };
 
-  passes[pending++] = Pass::WarmStart;
-  if (!pipeline) runPasses();
+  queue(Pass::WarmStart);
   const bool batches = part.batch_end > part.batch_begin;
   for (int it = 0; it < o.iterations; ++it) {
     if (o.randomize_order || it == 0) orderColours(order, part, o.randomize_order, rng_state);
-    passes[pending++] = Pass::Normals;
-    if (batches) passes[pending++] = Pass::Friction;  // a jointed scene without contacts has no friction pass
-    runPasses();
+    queue(Pass::Normals);
+    if (batches) queue(Pass::Friction);  // a jointed scene without contacts has no friction pass
+    endSweep();
     reduceSweep(p, part, true);
     stats.last_max_delta = 0;
     for (std::int32_t i = part.island_begin; i < part.island_end; ++i)
@@ -444,8 +442,7 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
     // No momentum after the last sweep: the result must be a PGS iterate.
     if (o.nncg && it + 1 < o.iterations) {
       islandBetas(p, part);
-      passes[pending++] = Pass::Momentum;
-      if (!pipeline) runPasses();
+      queue(Pass::Momentum);
     }
   }
   return stats;

@@ -91,8 +91,9 @@ class PassPipeline {
   bool planned_ = false;
   std::vector<FlowItem> items_;
   std::vector<std::int32_t> need_;  // per item: items of the pass before to wait for
-  // Planning scratch: per body, the last item to touch it; an item's bodies.
-  std::vector<std::int32_t> last_, bodies_;
+  // Planning scratch: per body, the last item to touch it; every item's
+  // bodies, item k's at [body_begin_[k], body_begin_[k + 1]).
+  std::vector<std::int32_t> last_, bodies_, body_begin_;
   std::unique_ptr<Progress[]> progress_;
 };
 

@@ -124,17 +124,20 @@ constexpr double kGroupWork = 1.0 / kGroupsPerBatchVisit;
 // (docs/performance.md).
 constexpr double kFlowWork = 256;
 
-// Below this many manifold batches, consecutive passes are not run side by
-// side (pass_pipeline.hpp). The trailing pass reads what the leading one
-// has just written on the other core (the bodies, the batch's impulses),
-// which made each of its batch visits about 1.6 times as long on the 2-core
-// Xeon of docs/performance.md; it pays only where a pass trails the one
-// before by a small share of its items. Measured, two threads against the
-// barrier per colour: pyramid-10's 39 batches (trailing by 8) solved a
-// quarter slower, pyramid-20's 111 (by 14) 8% faster, pyramid-30's 222 (by
-// 17) 1.3 times faster; chain-100's joints alone (100 row groups, each an
-// eighth of a batch visit) solved 15 to 40% slower, so row groups do not
-// count.
+// Below this many manifold batches, consecutive passes do not overlap
+// (pass_pipeline.hpp). On a pool, the trailing pass reads what the leading
+// one has just written on the other core (the bodies, the batch's
+// impulses), which made each of its batch visits about 1.6 times as long
+// on the 2-core Xeon of docs/performance.md; it pays only where a pass
+// trails the one before by a small share of its items. Measured, two
+// threads against the barrier per colour: pyramid-10's 39 batches
+// (trailing by 8) solved a quarter slower, pyramid-20's 111 (by 14) 8%
+// faster, pyramid-30's 222 (by 17) 1.3 times faster; chain-100's joints
+// alone (100 row groups, each an eighth of a batch visit) solved 15 to 40%
+// slower, so row groups do not count. On one thread the interleave pays
+// once the batches outgrow the core's cache, and costs nothing below:
+// pyramid-20 (111 batches, 1.4 MB) solved as fast as pass after pass,
+// pyramid-30 1.16 times and the 5,050-box pyramid 1.35 times faster.
 constexpr int kPipelineBatches = 96;
 
 // Runs fn(begin, end) over [0, count), on the pool's threads if there is one
@@ -350,12 +353,12 @@ void startSweeps(GraphProblem& p) {
 // The passes of a sweep over a part's constraints.
 enum class Pass { WarmStart, Normals, Friction, Momentum };
 
-// Whether the passes of this problem run side by side (pass_pipeline.hpp):
-// one part in colour order with a pool, no flow schedule (which shares each
-// pass's colours instead, and is chosen past its own, larger size), and
-// enough batches.
+// Whether the passes of this problem overlap (pass_pipeline.hpp), side by
+// side on the pool or interleaved on one thread: one part in colour order,
+// no flow schedule (which shares each pass's colours between the threads
+// instead, and is chosen past its own, larger size), and enough batches.
 bool usePipeline(GraphProblem& p, const GraphSolveOptions& o, bool flow) {
-  if (!o.pool || flow || o.randomize_order || partCount(p, o) != 1) return false;
+  if (!o.overlap_passes || flow || o.randomize_order || partCount(p, o) != 1) return false;
   if (static_cast<int>(p.batches.size()) < kPipelineBatches) return false;
   if (!p.pipeline.planned()) p.pipeline.plan(p, o.dynamic_end);
   return true;
@@ -418,10 +421,12 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
   };
   const auto endSweep = [&] {
     if (pending == 0) return;
-    p.pipeline.run(*o.pool, pending, [&](int j, const FlowItem& it) {
+    const auto item = [&](int j, const FlowItem& it) {
       forItems(p.colours[static_cast<size_t>(it.colour)], it.item, it.item + 1, groupFn(passes[j]),
                batchFn(passes[j]));
-    });
+    };
+    if (o.pool) p.pipeline.run(*o.pool, pending, item);
+    else p.pipeline.runInterleaved(pending, item);
     pending = 0;
   };
 

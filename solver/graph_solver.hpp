@@ -93,8 +93,9 @@ struct GraphProblem {
   // One part with a pool: the colours' schedule without barriers
   // (colour_flow.hpp), planned at the first pass over this problem.
   ColourFlow flow;
-  // One part with a pool and no flow schedule: consecutive passes side by
-  // side (pass_pipeline.hpp), planned at the first sweep.
+  // One part and no flow schedule: consecutive passes overlapped, side by
+  // side on a pool or interleaved on one thread (pass_pipeline.hpp),
+  // planned at the first sweep.
   PassPipeline pipeline;
 
   void clear() {
@@ -121,6 +122,11 @@ struct GraphSolveOptions {
   int friction_rows = 2;  // tangent rows per contact point
   const ContactKernels* kernels = nullptr;
   WorkerPool* pool = nullptr;  // null: this thread only
+  // Where planned, consecutive passes of a sweep overlap (pass_pipeline.hpp):
+  // side by side on the pool, interleaved on one thread. false runs each
+  // pass over every constraint before the next, the order that defines the
+  // bits (the tests compare the two).
+  bool overlap_passes = true;
 };
 
 // Warm start and the velocity sweeps.

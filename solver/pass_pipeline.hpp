@@ -21,6 +21,15 @@
 // leading one has just written on another core, so it pays only where a
 // pass trails by a small share of its items (graph_solver.cpp,
 // kPipelineBatches; docs/performance.md).
+//
+// On one thread the same plan interleaves the passes: after each item of
+// the leading pass, every later pass runs as far as its needs allow. The
+// order differs from pass after pass only between constraints that share
+// no body, so the bits are the same; what changes is the memory traffic.
+// A pass after pass sweep streams every batch from beyond the core's
+// cache once per pass when the island's batches outgrow it (a
+// 5,050-box pyramid's are 24 MB); interleaved, the trailing passes find a
+// batch and its bodies where the leading pass left them, a level back.
 #pragma once
 
 #include "solver/colour_flow.hpp"
@@ -59,6 +68,25 @@ class PassPipeline {
   void plan(const GraphProblem& p, int dynamic_end);
   bool planned() const { return planned_; }
   void reset() { planned_ = false; }
+
+  // Runs fn(j, item) for passes j = 0 .. passes - 1 over every item on the
+  // calling thread, interleaved: after each item of the first pass not yet
+  // done, every later pass runs as far as its needs allow.
+  template <class F>
+  void runInterleaved(int passes, F&& fn) {
+    const std::int32_t n = static_cast<std::int32_t>(items_.size());
+    std::int32_t pos[kMaxPasses] = {};
+    for (int first = 0; first < passes;) {
+      if (pos[first] == n) {
+        ++first;
+        continue;
+      }
+      fn(first, items_[static_cast<size_t>(pos[first]++)]);
+      for (int j = first + 1; j < passes; ++j)
+        while (pos[j] < n && need_[static_cast<size_t>(pos[j])] <= pos[j - 1])
+          fn(j, items_[static_cast<size_t>(pos[j]++)]);
+    }
+  }
 
   // Runs fn(j, item) for passes j = 0 .. passes - 1 over every item, on
   // min(passes, pool threads) threads.

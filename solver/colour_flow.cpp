@@ -41,6 +41,7 @@ ColourFlow& ColourFlow::operator=(const ColourFlow& o) {
   thread_begin_ = o.thread_begin_;
   items_ = o.items_;
   need_ = o.need_;
+  prev_need_ = o.prev_need_;
   progress_size_ = o.progress_size_;
   progress_ = progress_size_ > 0 ? std::make_unique<Progress[]>(static_cast<size_t>(progress_size_)) : nullptr;
   return *this;
@@ -138,6 +139,11 @@ void ColourFlow::commit(std::int32_t colour, const std::vector<Run>& runs) {
       free_[t] = s.finish;
       load_[t] += item_work_[static_cast<size_t>(i)];
       sequence_.push_back(s);
+      for (const std::int32_t b : bodiesOf(i)) {
+        sequence_bodies_.push_back(b);
+        last_at_[static_cast<size_t>(b) * T + t] = s.at;  // a thread's items come in order
+      }
+      sequence_body_begin_.push_back(static_cast<std::int32_t>(sequence_bodies_.size()));
     }
   }
   // The items of a colour share no body, so their marks can go in after
@@ -160,6 +166,9 @@ bool ColourFlow::plan(const GraphProblem& p, int threads, int dynamic_end, doubl
   load_.assign(T, 0);
   free_.assign(T, 0);
   last_.assign(static_cast<size_t>(std::max(dynamic_end, 1)), -1);
+  last_at_.assign(static_cast<size_t>(std::max(dynamic_end, 1)) * T, -1);
+  sequence_bodies_.clear();
+  sequence_body_begin_.assign(1, 0);
 
   // Who sweeps what, colour by colour, each colour cut the way that ends it
   // soonest in the plan's model (list scheduling): one contiguous run of
@@ -215,16 +224,27 @@ bool ColourFlow::plan(const GraphProblem& p, int threads, int dynamic_end, doubl
   for (size_t t = 0; t < T; ++t) thread_begin_[t + 1] = thread_begin_[t] + count_[t];
   items_.resize(sequence_.size());
   need_.resize(need_sequence_.size());
+  prev_need_.resize(need_sequence_.size());
   for (size_t q = 0; q < sequence_.size(); ++q) {
     const Planned& s = sequence_[q];
     const size_t k = static_cast<size_t>(thread_begin_[static_cast<size_t>(s.thread)] + s.at);
     items_[k] = s.item;
     std::copy_n(need_sequence_.begin() + static_cast<std::ptrdiff_t>(q * T), T,
                 need_.begin() + static_cast<std::ptrdiff_t>(k * T));
+    // The pass before, for interleaved passes: per thread, its last item
+    // over the whole pass to touch one of this item's bodies.
+    std::int32_t* prev = prev_need_.data() + k * T;
+    std::fill_n(prev, T, 0);
+    prev[static_cast<size_t>(s.thread)] = s.at + 1;
+    for (std::int32_t e = sequence_body_begin_[q]; e < sequence_body_begin_[q + 1]; ++e) {
+      const size_t b = static_cast<size_t>(sequence_bodies_[static_cast<size_t>(e)]);
+      for (size_t u = 0; u < T; ++u) prev[u] = std::max(prev[u], last_at_[b * T + u] + 1);
+    }
   }
-  if (progress_size_ < threads) {
-    progress_ = std::make_unique<Progress[]>(T);
-    progress_size_ = threads;
+  const int progress = kMaxOverlappedPasses * threads;
+  if (progress_size_ < progress) {
+    progress_ = std::make_unique<Progress[]>(static_cast<size_t>(progress));
+    progress_size_ = progress;
   }
   return true;
 }

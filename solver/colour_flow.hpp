@@ -41,6 +41,10 @@ namespace cairn {
 
 struct GraphProblem;
 
+// The most passes one overlapped run takes (pass_pipeline.hpp): the warm
+// start or momentum, then the normal rows and the friction rows.
+inline constexpr int kMaxOverlappedPasses = 3;
+
 // Item `item` of colour `colour`: its row groups, then its batches
 // (graph_solver.cpp's item numbering).
 struct FlowItem {
@@ -83,10 +87,68 @@ class ColourFlow {
     pool.parallelFor(threads_, [&](int t, int) { runThread(t, fn); });
   }
 
+  // Runs fn(j, item) for consecutive passes j = 0 .. passes - 1 over every
+  // item, each thread its own items in every pass, interleaved as on one
+  // thread (pass_pipeline.hpp): after each item of its first unfinished
+  // pass, a thread runs its later passes' items as far as they are ready.
+  // An item of pass j is ready when the items of pass j it waits for in
+  // run() are done, and those of pass j - 1 that touch its bodies, on any
+  // thread. Only the first unfinished pass waits; no wait can deadlock: the
+  // earliest unfinished item of the lowest unfinished pass waits for
+  // nothing.
+  template <class F>
+  void runInterleaved(WorkerPool& pool, int passes, F&& fn) {
+    for (int k = 0; k < passes * threads_; ++k) progress_[k].done.store(0, std::memory_order_relaxed);
+    pool.parallelFor(threads_, [&](int t, int) { runThreadInterleaved(t, passes, fn); });
+  }
+
  private:
   struct alignas(64) Progress {
     std::atomic<std::int32_t> done{0};  // items of this thread finished in this pass
   };
+
+  // Whether thread u has done `count` of its items in pass j; waits for it
+  // if `wait`.
+  bool reached(int j, int u, std::int32_t count, bool wait) const {
+    const std::atomic<std::int32_t>& done = progress_[j * threads_ + u].done;
+    if (wait) return WorkerPool::waitAtLeast(done, count) >= count;
+    return done.load(std::memory_order_acquire) >= count;
+  }
+
+  template <class F>
+  void runThreadInterleaved(int t, int passes, F& fn) {
+    const std::int32_t first = thread_begin_[static_cast<size_t>(t)];
+    const std::int32_t n = thread_begin_[static_cast<size_t>(t) + 1] - first;
+    std::int32_t pos[kMaxOverlappedPasses] = {};
+    const auto ready = [&](int j, bool wait) {
+      const size_t k = static_cast<size_t>(first + pos[j]) * static_cast<size_t>(threads_);
+      for (int u = 0; u < threads_; ++u) {
+        const std::int32_t same = need_[k + static_cast<size_t>(u)];
+        const std::int32_t before = j > 0 ? prev_need_[k + static_cast<size_t>(u)] : 0;
+        if (u == t) {
+          if (j > 0 && before > pos[j - 1]) return false;  // this thread's own pass before
+          continue;
+        }
+        if (same > 0 && !reached(j, u, same, wait)) return false;
+        if (before > 0 && !reached(j - 1, u, before, wait)) return false;
+      }
+      return true;
+    };
+    const auto step = [&](int j) {
+      fn(j, items_[static_cast<size_t>(first + pos[j])]);
+      progress_[j * threads_ + t].done.store(++pos[j], std::memory_order_release);
+    };
+    for (int lead = 0; lead < passes;) {
+      if (pos[lead] == n) {
+        ++lead;
+        continue;
+      }
+      ready(lead, true);
+      step(lead);
+      for (int j = lead + 1; j < passes; ++j)
+        while (pos[j] < n && ready(j, false)) step(j);
+    }
+  }
 
   template <class F>
   void runThread(int t, F& fn) {
@@ -106,6 +168,10 @@ class ColourFlow {
   std::vector<std::int32_t> thread_begin_;  // thread t's items: [thread_begin_[t], thread_begin_[t + 1])
   std::vector<FlowItem> items_;             // by thread, each thread's in the order it visits them
   std::vector<std::int32_t> need_;          // per item and thread u: items of u to wait for
+  // Per item and thread u: items of u to wait for in the pass before, when
+  // passes are interleaved: up to the last of u's items to touch one of
+  // its bodies in the whole pass (and on its own thread, itself).
+  std::vector<std::int32_t> prev_need_;
   std::unique_ptr<Progress[]> progress_;
   int progress_size_ = 0;
 
@@ -137,6 +203,9 @@ class ColourFlow {
   std::vector<std::int32_t> count_;            // per thread: items so far
   std::vector<std::int64_t> load_, free_;      // per thread: work so far, and when it is free
   std::vector<std::int32_t> last_;             // per body: the last item (in sequence_) to touch it
+  std::vector<std::int32_t> last_at_;          // per body and thread: that thread's last item to touch it
+  std::vector<std::int32_t> sequence_bodies_;  // every planned item's bodies, sequence_[q]'s from
+  std::vector<std::int32_t> sequence_body_begin_;  // sequence_body_begin_[q]
   std::vector<std::int32_t> item_work_;        // the colour's items: work in eighths of a batch visit,
   std::vector<std::int32_t> item_body_begin_;  // and dynamic bodies
   std::vector<std::int32_t> item_bodies_;

@@ -372,6 +372,7 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
   double* body_data = bodies.front().v.data();
   const bool flow = useFlow(p, o);
   const bool pipeline = usePipeline(p, o, flow);
+  const bool overlap = pipeline || (flow && o.overlap_passes);
   const ContactSweepParams warm = sweepParams(p, o, false);
   const ContactSweepParams sp = sweepParams(p, o, o.nncg);
 
@@ -404,14 +405,15 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
       }
     };
   };
-  // Without the pipeline a pass runs as soon as it is queued (the warm
-  // start in storage order, the others in this sweep's colour order, so a
-  // shuffled order is the one of its own sweep); with it, the passes queued
-  // since the last sweep's end run side by side at the next.
-  Pass passes[PassPipeline::kMaxPasses];
+  // Without overlap a pass runs as soon as it is queued (the warm start in
+  // storage order, the others in this sweep's colour order, so a shuffled
+  // order is the one of its own sweep); with it, the passes queued since
+  // the last sweep's end overlap at the next: interleaved by the flow
+  // schedule's threads, else by the pipeline.
+  Pass passes[kMaxOverlappedPasses];
   int pending = 0;
   const auto queue = [&](Pass pass) {
-    if (pipeline) {
+    if (overlap) {
       passes[pending++] = pass;
     } else if (pass == Pass::WarmStart) {
       forColours(p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end), groupFn(pass), batchFn(pass));
@@ -425,7 +427,8 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
       forItems(p.colours[static_cast<size_t>(it.colour)], it.item, it.item + 1, groupFn(passes[j]),
                batchFn(passes[j]));
     };
-    if (o.pool) p.pipeline.run(*o.pool, pending, item);
+    if (flow) p.flow.runInterleaved(*o.pool, pending, item);
+    else if (o.pool) p.pipeline.run(*o.pool, pending, item);
     else p.pipeline.runInterleaved(pending, item);
     pending = 0;
   };

@@ -47,11 +47,7 @@ struct GraphProblem;
 
 class PassPipeline {
  public:
-  // The most passes one run takes: the warm start or momentum, then the
-  // normal rows and the friction rows.
-  static constexpr int kMaxPasses = 3;
-
-  PassPipeline() : progress_(std::make_unique<Progress[]>(kMaxPasses)) {}
+  PassPipeline() : progress_(std::make_unique<Progress[]>(kMaxOverlappedPasses)) {}
   // A copy has the plan but counters of its own.
   PassPipeline(const PassPipeline& o) : PassPipeline() { *this = o; }
   PassPipeline& operator=(const PassPipeline& o) {
@@ -75,7 +71,7 @@ class PassPipeline {
   template <class F>
   void runInterleaved(int passes, F&& fn) {
     const std::int32_t n = static_cast<std::int32_t>(items_.size());
-    std::int32_t pos[kMaxPasses] = {};
+    std::int32_t pos[kMaxOverlappedPasses] = {};
     for (int first = 0; first < passes;) {
       if (pos[first] == n) {
         ++first;

@@ -12,6 +12,7 @@
 // be equal bit for bit (==), not within a tolerance.
 #include "solver/contact_kernels.hpp"
 #include "solver/graph_solver.hpp"
+#include "solver/worker_pool.hpp"
 #include "test_helpers.hpp"
 #include "validation/scenarios.hpp"
 #include "world/parallel_thresholds.hpp"
@@ -147,8 +148,8 @@ TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
 // (kParallelWork); with randomize_order the sweeps take that path too. The
 // test checks the paths were taken, on two threads and on four, then
 // compares 20 steps on 1, 2 and 4 threads, in colour order and shuffled
-// (one thread interleaves the same passes: the next test checks that
-// against pass after pass).
+// (OverlappedPassesGiveTheBitsOfPassAfterPass checks each overlap against
+// pass after pass).
 TEST(Determinism, MidSizedPyramidRunsItsPassesSideBySideAndIsBitIdentical) {
   const SceneDesc s = scenarios::pyramid(30);
   constexpr int kSplitColour = 4;  // graph_solver.cpp, kParallelWork
@@ -174,46 +175,67 @@ TEST(Determinism, MidSizedPyramidRunsItsPassesSideBySideAndIsBitIdentical) {
   }
 }
 
-// On one thread the passes of a sweep are interleaved where the pipeline is
-// planned (pass_pipeline.hpp): each trailing pass runs as soon as the items
-// it needs are done. That reorders only constraints that share no body, so
-// the impulses and velocities must be those of pass after pass, bit for
-// bit, with NNCG's momentum pass and without it. The problem is a mid-sized
-// pyramid's as the step left it (warm impulses, the bodies' velocities).
-TEST(Determinism, OneThreadInterleavesTheSweepsPassesWithTheBitsOfPassAfterPass) {
-  World w = buildWorld(scenarios::pyramid(30));
-  for (int k = 0; k < 3; ++k) w.step(1.0 / 60);
+// Solves the graph the step left in `w` twice from the same state, its
+// passes overlapped and pass after pass, and compares the impulses and
+// velocities with ==.
+enum class Overlap { Interleaved, SideBySide, FlowInterleaved };
+void expectOverlapGivesTheBitsOfPassAfterPass(const World& w, WorkerPool* pool, Overlap overlap) {
   const detail::StepContext& ctx = detail::internals(w).stepContext();
   for (const bool nncg : {true, false}) {
     GraphSolveOptions o;
     o.nncg = nncg;
     o.dynamic_end = ctx.dynamic_count + 1;
     o.kernels = &contactKernels(bestSimdLevel());
-    GraphProblem interleaved = ctx.graph, in_turn = ctx.graph;
-    interleaved.pipeline.reset();
-    in_turn.pipeline.reset();
-    std::vector<SolverBody> v_interleaved = ctx.velocities, v_in_turn = ctx.velocities;
+    o.pool = pool;
+    GraphProblem overlapped = ctx.graph, in_turn = ctx.graph;
+    for (GraphProblem* g : {&overlapped, &in_turn}) {
+      g->pipeline.reset();
+      g->flow.reset();
+    }
+    std::vector<SolverBody> v_overlapped = ctx.velocities, v_in_turn = ctx.velocities;
     std::uint64_t rng = 1;
-    solveGraph(interleaved, v_interleaved, o, rng);
+    solveGraph(overlapped, v_overlapped, o, rng);
     o.overlap_passes = false;
     solveGraph(in_turn, v_in_turn, o, rng);
-    ASSERT_TRUE(interleaved.pipeline.planned());
+    ASSERT_EQ(overlapped.flow.ready(), overlap == Overlap::FlowInterleaved);
+    ASSERT_EQ(overlapped.pipeline.planned(), overlap != Overlap::FlowInterleaved);
     ASSERT_FALSE(in_turn.pipeline.planned());
     for (size_t i = 0; i < v_in_turn.size(); ++i) {
-      EXPECT_EQ(v_interleaved[i].v, v_in_turn[i].v) << "body " << i;
-      EXPECT_EQ(v_interleaved[i].w, v_in_turn[i].w) << "body " << i;
+      EXPECT_EQ(v_overlapped[i].v, v_in_turn[i].v) << "body " << i;
+      EXPECT_EQ(v_overlapped[i].w, v_in_turn[i].w) << "body " << i;
     }
     int differ = 0;
     for (size_t b = 0; b < in_turn.batches.size(); ++b)
       for (int i = 0; i < kMaxPoints; ++i)
         for (int l = 0; l < kBatchLanes; ++l) {
-          const ContactBatch::Point& p = interleaved.batches[b].p[i];
+          const ContactBatch::Point& p = overlapped.batches[b].p[i];
           const ContactBatch::Point& q = in_turn.batches[b].p[i];
           differ += p.lambda[l] != q.lambda[l] || p.lambda_t[0][l] != q.lambda_t[0][l] ||
                     p.lambda_t[1][l] != q.lambda_t[1][l];
         }
     EXPECT_EQ(differ, 0) << (nncg ? "NNCG" : "PGS");
   }
+}
+
+// Where planned, the passes of a sweep overlap (solver/pass_pipeline.hpp):
+// interleaved on one thread, side by side on a pool, and interleaved by
+// each thread of the flow schedule (solver/colour_flow.hpp) on a large
+// island. Each reorders only constraints that share no body, so the
+// impulses and velocities must be those of pass after pass, bit for bit,
+// with NNCG's momentum pass and without it. The problems are pyramids' as
+// the step left them (warm impulses, the bodies' velocities): base 30 is
+// past the pipeline's size, base 60 past the flow schedule's.
+TEST(Determinism, OverlappedPassesGiveTheBitsOfPassAfterPass) {
+  World mid = buildWorld(scenarios::pyramid(30));
+  World large = buildWorld(scenarios::pyramid(60));
+  for (int k = 0; k < 3; ++k) {
+    mid.step(1.0 / 60);
+    large.step(1.0 / 60);
+  }
+  WorkerPool pool(2);
+  expectOverlapGivesTheBitsOfPassAfterPass(mid, nullptr, Overlap::Interleaved);
+  expectOverlapGivesTheBitsOfPassAfterPass(mid, &pool, Overlap::SideBySide);
+  expectOverlapGivesTheBitsOfPassAfterPass(large, &pool, Overlap::FlowInterleaved);
 }
 
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {

@@ -28,6 +28,7 @@
 #include "solver/colour_flow.hpp"
 #include "solver/contact_batch.hpp"
 #include "solver/contact_kernels.hpp"
+#include "solver/huge_page_allocator.hpp"
 #include "solver/pass_pipeline.hpp"
 #include "solver/solver_body.hpp"
 
@@ -64,7 +65,7 @@ struct GraphColour {
 // One step's PGS problem, rebuilt by the step each (sub)step; vectors keep
 // their capacity, so nothing is allocated once the scene has warmed up.
 struct GraphProblem {
-  std::vector<ContactBatch> batches;  // by colour
+  std::vector<ContactBatch, HugePageAllocator<ContactBatch>> batches;  // by colour
   std::vector<RowGroup> groups;       // by colour
   std::vector<ConstraintRow> rows;    // the groups' rows
   std::vector<GraphColour> colours;

@@ -2,14 +2,14 @@
 // them with 2 MiB pages (transparent huge pages, madvise).
 //
 // A large island's contact batches are tens of megabytes (13 KB a batch:
-// 25 MB for the 5,050-box pyramid), walked once or more per sweep. With
+// 24 MB for the 5,050-box pyramid), walked once or more per sweep. With
 // 4 KiB pages a batch spans four pages and the walk leaves the reach of
-// the core's TLB (1,536 entries, 6 MB), so most batches cost page walks;
-// with 2 MiB pages the whole array takes a dozen entries. Debian's
-// default is THP on madvise only, so the memory must ask for it. Measured
-// on the 5,050-box pyramid: its solve 1.1 times faster on one thread
-// (docs/performance.md). Below 2 MiB, or off Linux, this is the plain
-// aligned allocation.
+// the core's second-level TLB (1,536 to 2,048 entries on recent Xeons, 6
+// to 8 MB), so most batches cost page walks; with 2 MiB pages the whole
+// array takes a dozen entries. Debian's default is THP on madvise only,
+// so the memory must ask for it. Measured on the 5,050-box pyramid: its
+// solve 1.15 times faster on one thread (docs/performance.md). Below
+// 2 MiB, or off Linux, this is the plain aligned allocation.
 #pragma once
 
 #include <cstddef>

@@ -45,6 +45,30 @@ struct GraphProblem;
 // start or momentum, then the normal rows and the friction rows.
 inline constexpr int kMaxOverlappedPasses = 3;
 
+// Runs `passes` consecutive passes of `n` items each, interleaved, on the
+// calling thread: one item of the first unfinished pass (the lead), then
+// each later pass's items as far as they are ready; again until every pass
+// is done. ready(j, pos, wait) says whether pass j's next item, pos[j], may
+// run (pos[k] is pass k's count of items done); with `wait` it may wait for
+// other threads first, and it is asked so only for the lead, whose passes
+// before are all done. run(j, i) runs pass j's item i. The one-thread
+// pipeline (pass_pipeline.hpp) and each of the flow's threads (below) run
+// their passes through it.
+template <class Ready, class Run>
+void interleavePasses(int passes, std::int32_t n, Ready&& ready, Run&& run) {
+  std::int32_t pos[kMaxOverlappedPasses] = {};
+  for (int lead = 0; lead < passes;) {
+    if (pos[lead] == n) {
+      ++lead;
+      continue;
+    }
+    ready(lead, pos, true);
+    run(lead, pos[lead]++);
+    for (int j = lead + 1; j < passes; ++j)
+      while (pos[j] < n && ready(j, pos, false)) run(j, pos[j]++);
+  }
+}
+
 // Item `item` of colour `colour`: its row groups, then its batches
 // (graph_solver.cpp's item numbering).
 struct FlowItem {
@@ -119,8 +143,7 @@ class ColourFlow {
   void runThreadInterleaved(int t, int passes, F& fn) {
     const std::int32_t first = thread_begin_[static_cast<size_t>(t)];
     const std::int32_t n = thread_begin_[static_cast<size_t>(t) + 1] - first;
-    std::int32_t pos[kMaxOverlappedPasses] = {};
-    const auto ready = [&](int j, bool wait) {
+    const auto ready = [&](int j, const std::int32_t* pos, bool wait) {
       const size_t k = static_cast<size_t>(first + pos[j]) * static_cast<size_t>(threads_);
       for (int u = 0; u < threads_; ++u) {
         const std::int32_t same = need_[k + static_cast<size_t>(u)];
@@ -134,20 +157,10 @@ class ColourFlow {
       }
       return true;
     };
-    const auto step = [&](int j) {
-      fn(j, items_[static_cast<size_t>(first + pos[j])]);
-      progress_[j * threads_ + t].done.store(++pos[j], std::memory_order_release);
-    };
-    for (int lead = 0; lead < passes;) {
-      if (pos[lead] == n) {
-        ++lead;
-        continue;
-      }
-      ready(lead, true);
-      step(lead);
-      for (int j = lead + 1; j < passes; ++j)
-        while (pos[j] < n && ready(j, false)) step(j);
-    }
+    interleavePasses(passes, n, ready, [&](int j, std::int32_t i) {
+      fn(j, items_[static_cast<size_t>(first + i)]);
+      progress_[j * threads_ + t].done.store(i + 1, std::memory_order_release);
+    });
   }
 
   template <class F>

@@ -70,18 +70,12 @@ class PassPipeline {
   // done, every later pass runs as far as its needs allow.
   template <class F>
   void runInterleaved(int passes, F&& fn) {
-    const std::int32_t n = static_cast<std::int32_t>(items_.size());
-    std::int32_t pos[kMaxOverlappedPasses] = {};
-    for (int first = 0; first < passes;) {
-      if (pos[first] == n) {
-        ++first;
-        continue;
-      }
-      fn(first, items_[static_cast<size_t>(pos[first]++)]);
-      for (int j = first + 1; j < passes; ++j)
-        while (pos[j] < n && need_[static_cast<size_t>(pos[j])] <= pos[j - 1])
-          fn(j, items_[static_cast<size_t>(pos[j]++)]);
-    }
+    // The lead's passes before are done, so it is always ready.
+    const auto ready = [&](int j, const std::int32_t* pos, bool) {
+      return j == 0 || need_[static_cast<size_t>(pos[j])] <= pos[j - 1];
+    };
+    interleavePasses(passes, static_cast<std::int32_t>(items_.size()), ready,
+                     [&](int j, std::int32_t i) { fn(j, items_[static_cast<size_t>(i)]); });
   }
 
   // Runs fn(j, item) for passes j = 0 .. passes - 1 over every item, on

@@ -233,13 +233,9 @@ bool ColourFlow::plan(const GraphProblem& p, int threads, int dynamic_end, doubl
                 need_.begin() + static_cast<std::ptrdiff_t>(k * T));
     // The pass before, for interleaved passes: per thread, its last item
     // over the whole pass to touch one of this item's bodies.
-    std::int32_t* prev = prev_need_.data() + k * T;
-    std::fill_n(prev, T, 0);
-    prev[static_cast<size_t>(s.thread)] = s.at + 1;
-    for (std::int32_t e = sequence_body_begin_[q]; e < sequence_body_begin_[q + 1]; ++e) {
-      const size_t b = static_cast<size_t>(sequence_bodies_[static_cast<size_t>(e)]);
-      for (size_t u = 0; u < T; ++u) prev[u] = std::max(prev[u], last_at_[b * T + u] + 1);
-    }
+    const std::int32_t begin = sequence_body_begin_[q];
+    passBeforeNeed({sequence_bodies_.data() + begin, static_cast<size_t>(sequence_body_begin_[q + 1] - begin)},
+                   last_at_.data(), T, static_cast<size_t>(s.thread), s.at, prev_need_.data() + k * T);
   }
   const int progress = kMaxOverlappedPasses * threads;
   if (progress_size_ < progress) {

@@ -31,7 +31,9 @@
 
 #include "solver/worker_pool.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -67,6 +69,21 @@ void interleavePasses(int passes, std::int32_t n, Ready&& ready, Run&& run) {
     for (int j = lead + 1; j < passes; ++j)
       while (pos[j] < n && ready(j, pos, false)) run(j, pos[j]++);
   }
+}
+
+// The items of the pass before that an item waits for when passes are
+// interleaved, per thread u: up to u's last item over the whole pass to
+// touch one of the item's bodies, and on its own thread (`thread`, where
+// it is item `at`) itself, whose impulses it reads. last_at[b T + u] is
+// the place in u's order of u's last item to touch body b (-1: none).
+// Writes out[0 .. T). One thread's pipeline (pass_pipeline.cpp) and the
+// flow's threads (colour_flow.cpp) plan with it.
+inline void passBeforeNeed(std::span<const std::int32_t> bodies, const std::int32_t* last_at, std::size_t T,
+                           std::size_t thread, std::int32_t at, std::int32_t* out) {
+  for (std::size_t u = 0; u < T; ++u) out[u] = 0;
+  out[thread] = at + 1;
+  for (const std::int32_t b : bodies)
+    for (std::size_t u = 0; u < T; ++u) out[u] = std::max(out[u], last_at[static_cast<std::size_t>(b) * T + u] + 1);
 }
 
 // Item `item` of colour `colour`: its row groups, then its batches

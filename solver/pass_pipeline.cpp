@@ -26,12 +26,9 @@ void PassPipeline::plan(const GraphProblem& p, int dynamic_end) {
     body_begin_.push_back(static_cast<std::int32_t>(bodies_.size()));
   }
   need_.resize(items_.size());
-  for (size_t k = 0; k < items_.size(); ++k) {
-    std::int32_t need = static_cast<std::int32_t>(k) + 1;
-    for (std::int32_t q = body_begin_[k]; q < body_begin_[k + 1]; ++q)
-      need = std::max(need, last_[static_cast<size_t>(bodies_[static_cast<size_t>(q)])] + 1);
-    need_[k] = need;
-  }
+  for (size_t k = 0; k < items_.size(); ++k)  // the flow's plan of the pass before, on one thread
+    passBeforeNeed({bodies_.data() + body_begin_[k], static_cast<size_t>(body_begin_[k + 1] - body_begin_[k])},
+                   last_.data(), 1, 0, static_cast<std::int32_t>(k), &need_[k]);
 }
 
 }  // namespace cairn

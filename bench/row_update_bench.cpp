@@ -6,6 +6,14 @@
 //       captured from the World), one colour after another, as the step
 //       sweeps them. rows = valid points x 3 (one normal and two friction
 //       rows each); ns_per_row_update = time / (rows x sweeps).
+//   BM_ContactSolve/<kernels>   the same rows solved as the step solves
+//       them (solveGraph with the step's options: the warm start, then per
+//       sweep the normal blocks, the friction rows and NNCG's momentum,
+//       the passes interleaved where the step interleaves them);
+//       ns_per_row_update = time / (rows x sweeps), the other passes'
+//       time included. BM_ContactRowUpdate isolates the two row kernels,
+//       colour after colour; this is what the step pays per row, and where
+//       a change to a kernel must show to reach the step.
 //   BM_JointRowUpdate   the same over the joint rows of chain-100 after 30
 //       steps (mid-whip), each joint's rows in order.
 //
@@ -106,6 +114,41 @@ BENCHMARK(BM_ContactRowUpdate)
     ->DenseRange(0, 2)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
+
+void BM_ContactSolve(benchmark::State& state) {
+  const auto level = static_cast<SimdLevel>(state.range(0));
+  if (!simdLevelAvailable(level)) {
+    state.SkipWithError("instruction set not available here");
+    return;
+  }
+  static const Captured problem = capture("pyramid-20", 60);
+  if (problem.contact_rows == 0) {
+    state.SkipWithError("pyramid-20 left no contact rows in the PGS graph");
+    return;
+  }
+  const ContactKernels& k = contactKernels(level);
+  state.SetLabel(k.name);
+  GraphSolveOptions o;  // the step's defaults (SolverSettings): 10 sweeps, NNCG, two tangent rows
+  o.dynamic_end = problem.dynamic_end;
+  o.kernels = &k;
+  double seconds = 0, updates = 0;
+  std::uint64_t rng = 1;
+  for (auto _ : state) {
+    GraphProblem g = problem.graph;  // not timed: every run starts from the captured impulses
+    std::vector<SolverBody> v = problem.velocities;
+    const double t0 = threadSeconds();
+    const GraphSolveStats st = solveGraph(g, v, o, rng);
+    benchmark::DoNotOptimize(v.data());
+    benchmark::ClobberMemory();
+    const double dt = threadSeconds() - t0;
+    state.SetIterationTime(dt);
+    seconds += dt;
+    updates += problem.contact_rows * st.iterations;
+  }
+  state.counters["rows"] = problem.contact_rows;
+  state.counters["ns_per_row_update"] = updates > 0 ? 1e9 * seconds / updates : 0;
+}
+BENCHMARK(BM_ContactSolve)->ArgName("simd")->DenseRange(0, 2)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
 void BM_JointRowUpdate(benchmark::State& state) {
   static const Captured problem = capture("chain-100", 30);

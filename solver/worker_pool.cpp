@@ -1,9 +1,19 @@
 #include "solver/worker_pool.hpp"
 
+#include <chrono>
+
 namespace cairn {
 
 namespace {
 thread_local int t_thread_index = 0;
+// The pool whose loop this thread is running (a worker's own pool, or the
+// pool the calling thread has handed a loop to), for the count of waits
+// that lost the core; null outside a loop.
+thread_local WorkerPool* t_pool = nullptr;
+
+// A yield that returns after this long ran another task on the core: on an
+// idle core sched_yield returns in about a microsecond.
+constexpr auto kPreemptedYield = std::chrono::microseconds(50);
 
 // Spins this many times on an atomic before yielding, and yields this many
 // times before blocking on it: a loop of the step usually arrives within a
@@ -20,9 +30,15 @@ void WorkerPool::waitRound(int spin) {
 #if defined(__x86_64__) || defined(__i386__)
     __builtin_ia32_pause();
 #endif
-  } else {
-    std::this_thread::yield();
+    return;
   }
+  if (!t_pool) {
+    std::this_thread::yield();
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::this_thread::yield();
+  if (std::chrono::steady_clock::now() - start > kPreemptedYield) t_pool->preempted_.fetch_add(1, std::memory_order_relaxed);
 }
 
 std::int32_t WorkerPool::waitAtLeast(const std::atomic<std::int32_t>& counter, std::int32_t value) {
@@ -70,8 +86,10 @@ void WorkerPool::run(const Job& job) {
     generation_.fetch_add(1, std::memory_order_acq_rel);
   }
   wake_.notify_all();
+  t_pool = this;
   doChunk(job_, 0);
   for (int spin = 0; remaining_.load(std::memory_order_acquire) != 0; ++spin) waitRound(spin);
+  t_pool = nullptr;
 }
 
 void WorkerPool::workerLoop(int index) {
@@ -93,7 +111,9 @@ void WorkerPool::workerLoop(int index) {
     seen = now;
     if (stop_.load(std::memory_order_acquire)) return;
     const Job job = job_;
+    t_pool = this;  // only while it works: its idle waits are not counted
     if (index < job.chunks) doChunk(job, index);
+    t_pool = nullptr;
     remaining_.fetch_sub(1, std::memory_order_acq_rel);
   }
 }

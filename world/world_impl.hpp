@@ -347,7 +347,16 @@ class WorldImpl {
   StepContext ctx_;
   DirectSolver direct_solver_;  // keeps the structure's analysis (tree order or CHOLMOD's) while it holds
   DirectSolver position_solver_;  // the joint position pass's own (its rows' pattern differs)
-  std::unique_ptr<WorkerPool> pool_;
+  std::unique_ptr<WorkerPool> pool_;  // the step's threads; null: the calling thread alone
+  // The pool set aside while its threads were found sharing their cores
+  // with other work (world_step.cpp, watchPool): for solo_steps_ more
+  // steps, then taken back; solo_length_ steps the next time.
+  std::unique_ptr<WorkerPool> parked_pool_;
+  int solo_steps_ = 0;
+  int solo_length_ = 0;
+  // false: the pool is never set aside (the tests that must run every step
+  // on their threads, whatever else the machine runs).
+  bool pool_watch_ = true;
   std::uint64_t rng_state_ = 0;
   bool rng_seeded_ = false;
 

@@ -62,6 +62,7 @@ struct StepStats {
   int contact_points = 0;    ///< points of the touching manifolds
   int recycled_contacts = 0; ///< manifolds kept without a narrowphase run (SolverSettings::recycle_distance)
   int islands = 0;           ///< awake islands solved
+  int threads = 1;           ///< threads the step ran on: SolverSettings::threads, or 1 while the worker threads sit out steps after losing their cores to other work (docs/performance.md, "Threads")
   int sleeping_bodies = 0;   ///< bodies asleep after the step
   double max_penetration = 0;  ///< deepest contact after the step (m)
   double energy = 0;           ///< kinetic + potential (gravity, springs) after the step (J)

@@ -4,9 +4,31 @@
 #include "validation/scenarios.hpp"
 #include "world/world_access.hpp"
 
+#include <sched.h>
+
 #include <string>
 
 namespace cairn::test {
+
+// While alive, pins the calling thread, and the threads it starts, to the
+// core it runs on: a machine with no core to spare, made certain.
+class OneCore {
+ public:
+  OneCore() {
+    sched_getaffinity(0, sizeof saved_, &saved_);
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    const int cpu = sched_getcpu();
+    CPU_SET(cpu < 0 ? 0 : cpu, &one);
+    sched_setaffinity(0, sizeof one, &one);
+  }
+  ~OneCore() { sched_setaffinity(0, sizeof saved_, &saved_); }
+  OneCore(const OneCore&) = delete;
+  OneCore& operator=(const OneCore&) = delete;
+
+ private:
+  cpu_set_t saved_{};
+};
 
 inline BodyDef boxDef(const std::string& name, const Vec3& pos, Real mass = 1, const Vec3& he = Vec3(0.5, 0.5, 0.5)) {
   return scenarios::solid(name, mass, pos, ShapeDesc::box(he));

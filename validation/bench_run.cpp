@@ -64,8 +64,11 @@ Measured runOnce(BenchEngine e, const SceneDesc& scene, const OracleOptions& ora
   };
   if (e == BenchEngine::Cairn) {
     CairnRunner runner(scene, spec, m.run);
+    int alone = 0, steps = 0;  // steps on fewer threads than asked
     for (int s = 1; s <= scene.steps && runner.step(s); ++s) {
       const StepReading r = readLastStep(runner.world());
+      ++steps;
+      if (r.threads < scene.solver.threads) ++alone;
       for (int k = 0; k < kStageCount; ++k) m.stage_seconds[size_t(k)] += r.stage_seconds[size_t(k)];
       m.rows += r.rows;
       m.contacts += r.contacts;
@@ -73,6 +76,11 @@ Measured runOnce(BenchEngine e, const SceneDesc& scene, const OracleOptions& ora
       m.sleeping = r.sleeping_bodies;
       thin(s - 1);
     }
+    // A time on fewer threads than the table says must show.
+    if (alone > 0)
+      m.notes.push_back(std::to_string(alone) + " of " + std::to_string(steps) +
+                        " steps on one thread, not " + std::to_string(scene.solver.threads) +
+                        ": the worker threads were losing their cores to other work (StepStats::threads)");
   } else {
     BulletRunner runner(scene, spec, m.run, oracle);
     for (int s = 1; s <= scene.steps && runner.step(s); ++s) thin(s - 1);
@@ -176,7 +184,9 @@ BenchSceneResult runBenchScene(const BenchScene& scene, int repeats,
       const BenchEngine e = benchEngine((r + k) % kBenchEngineCount);
       const SceneDesc& s = scene.scenes[size_t(e)];
       BenchEngineResult& out = result.engines[size_t(e)];
-      const Measured m = runOnce(e, s, scene.oracle[size_t(e)], spec, spec.direct_reference);
+      Measured m = runOnce(e, s, scene.oracle[size_t(e)], spec, spec.direct_reference);
+      if (e == BenchEngine::Cairn)  // its notes are per scene, Bullet's the same for all
+        for (std::string& n : m.notes) n = scene.name + ", repeat " + std::to_string(r + 1) + ": " + n;
       const int steps = m.run.samples() - 1;
       out.steps = std::max(steps, 0);
       out.ms_per_step.push_back(steps > 0 ? 1e3 * m.seconds / steps : std::numeric_limits<double>::quiet_NaN());
@@ -198,8 +208,11 @@ BenchSceneResult runBenchScene(const BenchScene& scene, int repeats,
         out.exact_distance = f.exact;
         out.notes = m.notes;
         if (!m.run.failure.empty()) out.status = "stopped: " + m.run.failure;
-      } else if (!(f == first[size_t(e)]) && out.status == "ok") {
-        out.status = "repeat " + std::to_string(r + 1) + " gave other figures than the first (not deterministic)";
+      } else {
+        if (!(f == first[size_t(e)]) && out.status == "ok")
+          out.status = "repeat " + std::to_string(r + 1) + " gave other figures than the first (not deterministic)";
+        for (const std::string& n : m.notes)  // cairn's note on threads may differ between repeats
+          if (std::find(out.notes.begin(), out.notes.end(), n) == out.notes.end()) out.notes.push_back(n);
       }
       if (progress) progress(std::string(benchEngineName(e)) + " " + fmt("%.4g", out.ms_per_step.back()) + " ms/step");
     }

@@ -77,7 +77,7 @@ struct BenchEngineResult {
   int sleeping_bodies = 0;           // dynamic bodies asleep after the last step
   std::optional<double> rest_displacement, penetration, joint_error, exact_distance;
   std::string status = "ok";         // or why the run stopped, or that repeats disagreed
-  std::vector<std::string> notes;    // what the Bullet configuration could not map (BulletOracle::skipped)
+  std::vector<std::string> notes;    // what the Bullet configuration could not map (BulletOracle::skipped); for cairn, steps it ran on fewer threads than asked
 
   double medianMs() const;
   std::array<double, kStageCount> medianStageMs() const;

@@ -12,6 +12,7 @@ StepReading readLastStep(const World& world) {
   r.contacts = s.contacts;
   r.contact_points = s.contact_points;
   r.sleeping_bodies = s.sleeping_bodies;
+  r.threads = s.threads;
   return r;
 }
 

@@ -20,6 +20,7 @@ struct StepReading {
   int contacts = 0;        // touching manifolds
   int contact_points = 0;
   int sleeping_bodies = 0;
+  int threads = 1;         // threads the step ran on (StepStats::threads)
 };
 
 // The last step's statistics (World::lastStepStats()).

@@ -71,7 +71,7 @@ struct SolverSettings {
   bool nncg = true;             ///< PGS with NNCG momentum between sweeps (solver/pgs.cpp); false: plain PGS as Bullet
   std::uint64_t seed = 1;       ///< seed of the random row order (randomize_order): same seed, same run
   int substeps = 1;             ///< sub-steps per step
-  int threads = 1;              ///< worker threads for the step (results are bit-identical for any count)
+  int threads = 1;              ///< worker threads for the step (results are bit-identical for any count); while they lose their cores to other work the step runs on one (StepStats::threads)
   Simd simd = Simd::Auto;       ///< contact solver instruction set
   bool compute_residual = false;  ///< fill StepStats::residual (one extra pass over the rows)
 

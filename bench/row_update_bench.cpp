@@ -115,6 +115,30 @@ BENCHMARK(BM_ContactRowUpdate)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 
+// Times solveGraph over `g` with options `o`: `prepare(g)` (not timed)
+// sets its starting impulses before each run, and the figure is per row
+// update over `rows` rows and the sweeps each run made.
+template <class Prepare>
+void timeSolveGraph(benchmark::State& state, GraphProblem& g, const std::vector<SolverBody>& velocities, double rows,
+                    const GraphSolveOptions& o, Prepare&& prepare) {
+  double seconds = 0, updates = 0;
+  std::uint64_t rng = 1;
+  for (auto _ : state) {
+    std::vector<SolverBody> v = velocities;  // not timed
+    prepare(g);
+    const double t0 = threadSeconds();
+    const GraphSolveStats st = solveGraph(g, v, o, rng);
+    benchmark::DoNotOptimize(v.data());
+    benchmark::ClobberMemory();
+    const double dt = threadSeconds() - t0;
+    state.SetIterationTime(dt);
+    seconds += dt;
+    updates += rows * st.iterations;
+  }
+  state.counters["rows"] = rows;
+  state.counters["ns_per_row_update"] = updates > 0 ? 1e9 * seconds / updates : 0;
+}
+
 void BM_ContactSolve(benchmark::State& state) {
   const auto level = static_cast<SimdLevel>(state.range(0));
   if (!simdLevelAvailable(level)) {
@@ -131,22 +155,9 @@ void BM_ContactSolve(benchmark::State& state) {
   GraphSolveOptions o;  // the step's defaults (SolverSettings): 10 sweeps, NNCG, two tangent rows
   o.dynamic_end = problem.dynamic_end;
   o.kernels = &k;
-  double seconds = 0, updates = 0;
-  std::uint64_t rng = 1;
-  for (auto _ : state) {
-    GraphProblem g = problem.graph;  // not timed: every run starts from the captured impulses
-    std::vector<SolverBody> v = problem.velocities;
-    const double t0 = threadSeconds();
-    const GraphSolveStats st = solveGraph(g, v, o, rng);
-    benchmark::DoNotOptimize(v.data());
-    benchmark::ClobberMemory();
-    const double dt = threadSeconds() - t0;
-    state.SetIterationTime(dt);
-    seconds += dt;
-    updates += problem.contact_rows * st.iterations;
-  }
-  state.counters["rows"] = problem.contact_rows;
-  state.counters["ns_per_row_update"] = updates > 0 ? 1e9 * seconds / updates : 0;
+  GraphProblem g;
+  // Every run starts from the captured impulses.
+  timeSolveGraph(state, g, problem.velocities, problem.contact_rows, o, [&](GraphProblem& p) { p = problem.graph; });
 }
 BENCHMARK(BM_ContactSolve)->ArgName("simd")->DenseRange(0, 2)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
@@ -163,23 +174,10 @@ void BM_JointRowUpdate(benchmark::State& state) {
   o.nncg = false;
   o.dynamic_end = problem.dynamic_end;
   o.kernels = &contactKernels(bestSimdLevel());
-  double seconds = 0, updates = 0;
-  std::uint64_t rng = 1;
-  for (auto _ : state) {
-    std::vector<SolverBody> v = problem.velocities;  // not timed
-    for (ConstraintRow& r : g.rows) r.lambda = 0;  // cold: every sweep works
-    const double t0 = threadSeconds();
-    const GraphSolveStats st = solveGraph(g, v, o, rng);
-    benchmark::DoNotOptimize(v.data());
-    benchmark::ClobberMemory();
-    const double dt = threadSeconds() - t0;
-    state.SetIterationTime(dt);
-    seconds += dt;
-    updates += problem.joint_rows * st.iterations;
-  }
-  state.counters["rows"] = problem.joint_rows;
+  timeSolveGraph(state, g, problem.velocities, problem.joint_rows, o, [](GraphProblem& p) {
+    for (ConstraintRow& r : p.rows) r.lambda = 0;  // cold: every sweep works
+  });
   state.counters["colours"] = static_cast<double>(g.colours.size());
-  state.counters["ns_per_row_update"] = updates > 0 ? 1e9 * seconds / updates : 0;
 }
 BENCHMARK(BM_JointRowUpdate)->UseManualTime()->Unit(benchmark::kMicrosecond);
 

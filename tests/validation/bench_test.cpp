@@ -6,6 +6,7 @@
 // deactivate a resting stack, the matched Bullet and cairn do not, and
 // every engine repeats its figures bit for bit. No speed is asserted. Runs
 // are tens of steps to keep the suite fast.
+#include "../unit/test_helpers.hpp"
 #include "cli_test_helpers.hpp"
 #include "cairn/error.hpp"
 #include "validation/bench_plan.hpp"
@@ -14,8 +15,6 @@
 #include "validation/standard_scenes.hpp"
 
 #include <gtest/gtest.h>
-
-#include <sched.h>
 
 #include <algorithm>
 #include <cmath>
@@ -280,14 +279,11 @@ TEST(BenchRun, StepsOnFewerThreadsThanAskedAreNoted) {
   scene.steps = 30;
   validation::BenchOverrides o;
   o.threads = 2;
-  cpu_set_t saved, one;
-  sched_getaffinity(0, sizeof saved, &saved);
-  CPU_ZERO(&one);
-  CPU_SET(std::max(sched_getcpu(), 0), &one);
-  sched_setaffinity(0, sizeof one, &one);
-  const validation::BenchSceneResult r =
-      validation::runBenchScene(validation::makeBenchScene("pyramid-20", scene, o), 1);
-  sched_setaffinity(0, sizeof saved, &saved);
+  validation::BenchSceneResult r;
+  {
+    const test::OneCore pinned;
+    r = validation::runBenchScene(validation::makeBenchScene("pyramid-20", scene, o), 1);
+  }
   const std::vector<std::string> expected = {
       "pyramid-20, repeat 1: 28 of 30 steps on one thread, not 2: the worker threads were losing their cores to "
       "other work (StepStats::threads)"};

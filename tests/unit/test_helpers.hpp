@@ -6,7 +6,9 @@
 
 #include <sched.h>
 
+#include <atomic>
 #include <string>
+#include <thread>
 
 namespace cairn::test {
 
@@ -28,6 +30,29 @@ class OneCore {
 
  private:
   cpu_set_t saved_{};
+};
+
+// Another task busy on the core for as long as it lives (a spinning
+// thread, with the creating thread's affinity: under OneCore, that core),
+// as on a machine whose other processes leave the step no core to spare.
+// A thread that yields the core then gets it back only after a time slice.
+class BusyCore {
+ public:
+  BusyCore()
+      : spinner_([this] {
+          while (!stop_.load(std::memory_order_relaxed)) {
+          }
+        }) {}
+  ~BusyCore() {
+    stop_.store(true, std::memory_order_relaxed);
+    spinner_.join();
+  }
+  BusyCore(const BusyCore&) = delete;
+  BusyCore& operator=(const BusyCore&) = delete;
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread spinner_;
 };
 
 inline BodyDef boxDef(const std::string& name, const Vec3& pos, Real mass = 1, const Vec3& he = Vec3(0.5, 0.5, 0.5)) {

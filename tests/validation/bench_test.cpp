@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -271,9 +272,11 @@ TEST(BenchRun, BulletDefaultsDeactivateARestingStackWhereTheSceneDoesNot) {
 // with its two threads pinned to one core (a machine with no core to
 // spare), cairn sets its pool aside after its first step and tries it
 // again at step 18 (world/world_step.cpp), so 28 of 30 steps run on one
-// thread, and the bench says so per scene and repeat. On its own machine
-// the same run has no such note (not asserted: a busy CI machine may
-// share the cores).
+// thread, and the bench says so per scene and repeat. (A step whose waits
+// stay under the watch's 50 us is not found sharing, and the next step
+// tries the pool again: 27 or fewer, still most.) On its own machine the
+// same run has no such note (not asserted: a busy CI machine may share
+// the cores).
 TEST(BenchRun, StepsOnFewerThreadsThanAskedAreNoted) {
   SceneDesc scene = validation::standardScene("pyramid-20").scene;
   scene.steps = 30;
@@ -282,12 +285,18 @@ TEST(BenchRun, StepsOnFewerThreadsThanAskedAreNoted) {
   validation::BenchSceneResult r;
   {
     const test::OneCore pinned;
+    const test::BusyCore busy;
     r = validation::runBenchScene(validation::makeBenchScene("pyramid-20", scene, o), 1);
   }
-  const std::vector<std::string> expected = {
-      "pyramid-20, repeat 1: 28 of 30 steps on one thread, not 2: the worker threads were losing their cores to "
-      "other work (StepStats::threads)"};
-  EXPECT_EQ(r[validation::BenchEngine::Cairn].notes, expected);
+  const std::vector<std::string>& notes = r[validation::BenchEngine::Cairn].notes;
+  ASSERT_EQ(notes.size(), 1u);
+  const std::regex note(
+      "pyramid-20, repeat 1: ([0-9]+) of 30 steps on one thread, not 2: the worker threads were losing their cores "
+      "to other work \\(StepStats::threads\\)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_match(notes[0], m, note)) << notes[0];
+  EXPECT_GE(std::stoi(m[1].str()), 20);  // at least one run of 16 alone
+  EXPECT_LE(std::stoi(m[1].str()), 28);  // steps 1 and 18 on the pool, at least
 }
 
 // The bench measures with `cairn validate`'s rulers: on the same scene its

@@ -81,6 +81,8 @@ struct alignas(64) ContactBatch {
   // largest impulse (the per-island stopping test), and for NNCG the
   // squared norm of the changes.
   Lanes sweep_delta, sweep_lambda, change2;
+  // The same figures of the correction pass's sweep (its own stopping test).
+  Lanes bias_delta, bias_lambda;
 };
 
 // What the fill kernel reads to make a batch's eight lanes (the step
@@ -131,6 +133,12 @@ struct ContactSweepParams {
   // Per island: 1 while its sweeps go on, 0 once it has stopped (its lanes
   // are left as they are). Null: every island goes on.
   const double* island_active = nullptr;
+  // The split-impulse correction swept with the velocities: non-null, each
+  // normal visit also visits its lanes' correction blocks on `pseudo` (as
+  // ContactKernels::solve_bias does, with pseudo_active for its islands),
+  // while the batch's lines are in the cache.
+  double* pseudo = nullptr;
+  const double* pseudo_active = nullptr;
 };
 
 }  // namespace cairn

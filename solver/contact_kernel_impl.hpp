@@ -403,6 +403,10 @@ struct Kernel {
       ContactBatch& b = batches[bi];
       for (int o = 0; o < kBatchLanes; o += W) {
         if (lanesEmpty(b, o)) continue;
+        if (p.pseudo) {  // the correction's visit, while the lanes are in hand
+          const M bias_active = activeLanes(b, o, p.pseudo_active);
+          if (any(bias_active)) biasLanes(b, o, p.pseudo, p, sor, bias_active);
+        }
         const M active = activeLanes(b, o, p.island_active);
         if (!any(active)) continue;
         Pair s;
@@ -559,6 +563,45 @@ struct Kernel {
     }
   }
 
+  // One visit of lanes [o, o + W)'s normal blocks toward the correction
+  // targets, on the pseudo-velocities, from lambda_bias; the lanes' largest
+  // change and impulse go to bias_delta and bias_lambda.
+  CAIRN_INLINE void biasLanes(ContactBatch& b, int o, double* pseudo, const ContactSweepParams& p, D sor, M active) {
+    Pair s;
+    gather(pseudo, b, o, s);
+    const Mass m = loadMass(b, o);
+    const V3 n = ld3(b.n, o);
+    const D cfm = ld(b.cfm + o);
+    D res[4], lam[4], valid[4], inv_diag[4], dd[4];
+    const D n_dv = dot(n, sub(s.vb, s.va));
+    for (int i = 0; i < 4; ++i) {
+      const ContactBatch::Point& q = b.p[i];
+      valid[i] = ld(q.valid + o);
+      lam[i] = ld(q.lambda_bias + o);
+      inv_diag[i] = ld(q.normal_mass + o);
+      const D jv = n_dv + dot(ld3(q.rbn, o), s.wb) - dot(ld3(q.ran, o), s.wa);
+      res[i] = (ld(q.bias + o) - jv) * valid[i];
+    }
+    solveBlock(b, o, res, lam, valid, cfm, sor, inv_diag, dd);
+    D total = zero(), maxd = zero(), maxl = zero();
+    V3 ta = zero3(), tb = zero3();
+    for (int i = 0; i < 4; ++i) {
+      ContactBatch::Point& q = b.p[i];
+      dd[i] = sel(active, dd[i], zero());
+      lam[i] = sel(active, lam[i], ld(q.lambda_bias + o));
+      total += dd[i];
+      ta = add(ta, mul(ld3(q.ran, o), dd[i]));
+      tb = add(tb, mul(ld3(q.rbn, o), dd[i]));
+      st(q.lambda_bias + o, lam[i]);
+      maxd = vmax(maxd, vabs(dd[i]));
+      maxl = vmax(maxl, lam[i]);
+    }
+    applySum(s, m, Sum{mul(n, total), ta, tb});
+    st(b.bias_delta + o, maxd);
+    st(b.bias_lambda + o, maxl);
+    scatter(pseudo, b, o, s, p.dynamic_end, active);
+  }
+
   static void solveBias(ContactBatch* batches, int begin, int end, double* pseudo, const ContactSweepParams& p) {
     const D sor = splat(p.sor);
     for (int bi = begin; bi < end; ++bi) {
@@ -566,40 +609,7 @@ struct Kernel {
       for (int o = 0; o < kBatchLanes; o += W) {
         if (lanesEmpty(b, o)) continue;
         const M active = activeLanes(b, o, p.island_active);
-        if (!any(active)) continue;
-        Pair s;
-        gather(pseudo, b, o, s);
-        const Mass m = loadMass(b, o);
-        const V3 n = ld3(b.n, o);
-        const D cfm = ld(b.cfm + o);
-        D res[4], lam[4], valid[4], inv_diag[4], dd[4];
-        const D n_dv = dot(n, sub(s.vb, s.va));
-        for (int i = 0; i < 4; ++i) {
-          const ContactBatch::Point& q = b.p[i];
-          valid[i] = ld(q.valid + o);
-          lam[i] = ld(q.lambda_bias + o);
-          inv_diag[i] = ld(q.normal_mass + o);
-          const D jv = n_dv + dot(ld3(q.rbn, o), s.wb) - dot(ld3(q.ran, o), s.wa);
-          res[i] = (ld(q.bias + o) - jv) * valid[i];
-        }
-        solveBlock(b, o, res, lam, valid, cfm, sor, inv_diag, dd);
-        D total = zero(), maxd = zero(), maxl = zero();
-        V3 ta = zero3(), tb = zero3();
-        for (int i = 0; i < 4; ++i) {
-          ContactBatch::Point& q = b.p[i];
-          dd[i] = sel(active, dd[i], zero());
-          lam[i] = sel(active, lam[i], ld(q.lambda_bias + o));
-          total += dd[i];
-          ta = add(ta, mul(ld3(q.ran, o), dd[i]));
-          tb = add(tb, mul(ld3(q.rbn, o), dd[i]));
-          st(q.lambda_bias + o, lam[i]);
-          maxd = vmax(maxd, vabs(dd[i]));
-          maxl = vmax(maxl, lam[i]);
-        }
-        applySum(s, m, Sum{mul(n, total), ta, tb});
-        st(b.sweep_delta + o, maxd);
-        st(b.sweep_lambda + o, maxl);
-        scatter(pseudo, b, o, s, p.dynamic_end, active);
+        if (any(active)) biasLanes(b, o, pseudo, p, sor, active);
       }
     }
   }

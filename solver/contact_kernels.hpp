@@ -29,7 +29,9 @@ struct ContactKernels {
   // bounded by the normal impulses of the same sweep, as Bullet's
   // btSequentialImpulseConstraintSolver orders them. Each lane records its
   // largest change and impulse in sweep_delta and sweep_lambda (and, with
-  // gather_change, NNCG's changes); the friction pass adds to them.
+  // gather_change, NNCG's changes); the friction pass adds to them. With
+  // ContactSweepParams::pseudo, each normal visit also takes solve_bias's
+  // visit of the same lanes.
   void (*solve_normals)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
   void (*solve_friction)(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p);
   // NNCG's momentum step (pgs.hpp): lambda += beta p projected on the
@@ -39,7 +41,8 @@ struct ContactKernels {
   void (*momentum)(ContactBatch* batches, int begin, int end, double* bodies, const double* island_beta,
                    const ContactSweepParams& p);
   // The split-impulse correction pass: normal blocks toward the bias
-  // targets, on the pseudo-velocities, from lambda_bias.
+  // targets, on the pseudo-velocities, from lambda_bias; each lane records
+  // its largest change and impulse in bias_delta and bias_lambda.
   void (*solve_bias)(ContactBatch* batches, int begin, int end, double* pseudo, const ContactSweepParams& p);
   // Restitution, once per step after the solve: each manifold's points
   // that carried a normal impulse and approached faster than the threshold

@@ -264,40 +264,60 @@ void forColours(GraphProblem& p, bool flow, WorkerPool* pool, const Colours& col
   for (const std::int32_t ci : colours) forColour(p.colours[static_cast<size_t>(ci)], pool, groups_fn, batches_fn);
 }
 
+// The per-island figures a run of sweeps stops on: the velocity sweeps'
+// (and a correction pass of its own), or the correction's swept with the
+// velocities (sweepPart).
+struct IslandFigures {
+  std::vector<double>& active;  // 1 while the island's sweeps go on
+  std::vector<double>& delta;   // this sweep's largest change
+  std::vector<double>& lambda;  // and largest impulse
+  std::vector<int>* iterations;  // sweeps so far (null: not counted)
+};
+IslandFigures sweepFigures(GraphProblem& p) {
+  return {p.island_active, p.island_delta, p.island_lambda, &p.island_iterations};
+}
+IslandFigures fusedBiasFigures(GraphProblem& p) { return {p.bias_active, p.bias_delta, p.bias_lambda, nullptr}; }
+
+// A lane figure of the batches: a pass's largest change or impulse.
+using LaneFigure = double (ContactBatch::*)[kBatchLanes];
+
 // Each island's largest change and impulse of the sweep, gathered in
-// storage order (the same whatever the threads did).
-void reduceSweep(GraphProblem& p, const Part& part, bool contacts) {
-  std::fill(p.island_delta.begin() + part.island_begin, p.island_delta.begin() + part.island_end, 0.0);
-  std::fill(p.island_lambda.begin() + part.island_begin, p.island_lambda.begin() + part.island_end, 0.0);
-  const auto fold = [&](std::int32_t island, double delta, double lambda) {
+// storage order (the same whatever the threads did): the lanes' figures
+// `delta` and `lambda` (none when null), and the row groups' with `groups`.
+void reduceSweep(GraphProblem& p, IslandFigures f, const Part& part, LaneFigure delta, LaneFigure lambda,
+                 bool groups) {
+  std::fill(f.delta.begin() + part.island_begin, f.delta.begin() + part.island_end, 0.0);
+  std::fill(f.lambda.begin() + part.island_begin, f.lambda.begin() + part.island_end, 0.0);
+  const auto on = [&](std::int32_t island) { return f.active[static_cast<size_t>(island)] > 0; };
+  const auto fold = [&](std::int32_t island, double d, double l) {
     const size_t i = static_cast<size_t>(island);
     // NaN must win: a non-finite island never looks converged.
-    if (!(p.island_delta[i] >= delta)) p.island_delta[i] = delta;
-    if (!(p.island_lambda[i] >= lambda)) p.island_lambda[i] = lambda;
+    if (!(f.delta[i] >= d)) f.delta[i] = d;
+    if (!(f.lambda[i] >= l)) f.lambda[i] = l;
   };
-  if (contacts)
+  if (delta)
     for (std::int32_t bi = part.batch_begin; bi < part.batch_end; ++bi) {
       const ContactBatch& b = p.batches[static_cast<size_t>(bi)];
       for (int l = 0; l < kBatchLanes; ++l)
-        if (b.count[l] > 0 && active(p, b.island[l])) fold(b.island[l], b.sweep_delta[l], b.sweep_lambda[l]);
+        if (b.count[l] > 0 && on(b.island[l])) fold(b.island[l], (b.*delta)[l], (b.*lambda)[l]);
     }
-  for (std::int32_t g = part.group_begin; g < part.group_end; ++g) {
-    const RowGroup& grp = p.groups[static_cast<size_t>(g)];
-    if (active(p, grp.island))
-      fold(grp.island, p.group_delta[static_cast<size_t>(g)], p.group_lambda[static_cast<size_t>(g)]);
-  }
+  if (groups)
+    for (std::int32_t g = part.group_begin; g < part.group_end; ++g) {
+      const RowGroup& grp = p.groups[static_cast<size_t>(g)];
+      if (on(grp.island)) fold(grp.island, p.group_delta[static_cast<size_t>(g)], p.group_lambda[static_cast<size_t>(g)]);
+    }
 }
 
 // Stops the islands that reached the tolerance or a round-off fixed point;
 // returns whether any island goes on.
-bool stopConverged(GraphProblem& p, const Part& part, const GraphSolveOptions& o, int sweeps) {
+bool stopConverged(IslandFigures f, const Part& part, const GraphSolveOptions& o, int sweeps) {
   bool any = false;
   for (std::int32_t k = part.island_begin; k < part.island_end; ++k) {
     const size_t i = static_cast<size_t>(k);
-    if (p.island_active[i] == 0) continue;
-    p.island_iterations[i] = sweeps;
-    const double d = p.island_delta[i];
-    if ((o.tolerance > 0 && d <= o.tolerance) || d <= kRoundOff * p.island_lambda[i]) p.island_active[i] = 0;
+    if (f.active[i] == 0) continue;
+    if (f.iterations) (*f.iterations)[i] = sweeps;
+    const double d = f.delta[i];
+    if ((o.tolerance > 0 && d <= o.tolerance) || d <= kRoundOff * f.lambda[i]) f.active[i] = 0;
     else any = true;
   }
   return any;
@@ -351,6 +371,70 @@ void startSweeps(GraphProblem& p) {
   p.group_lambda.assign(p.groups.size(), Real(0));
 }
 
+// Something to correct: a push (bias > 0), or a pull on a row that can
+// pull (lo < 0). A negative bias on a one-sided row only permits approach.
+bool anyRowBias(const GraphProblem& p, Correction which) {
+  for (const ConstraintRow& r : p.rows)
+    if (r.correction == which && (r.bias_rhs > 0 || (r.bias_rhs < 0 && r.lo < 0))) return true;
+  return false;
+}
+
+// The correction pass starts from no impulse each (sub)step.
+void clearBiasImpulses(GraphProblem& p) {
+  for (ContactBatch& b : p.batches)
+    for (int i = 0; i < kMaxPoints; ++i) std::fill(std::begin(b.p[i].lambda_bias), std::end(b.p[i].lambda_bias), 0.0);
+}
+
+bool anyContactBias(const GraphProblem& p) {
+  for (const ContactBatch& b : p.batches)
+    for (int i = 0; i < kMaxPoints; ++i)
+      for (int l = 0; l < kBatchLanes; ++l)
+        if (b.p[i].bias[l] > 0) return true;
+  return false;
+}
+
+void biasGroup(GraphProblem& p, std::int32_t gi, std::span<SolverBody> bodies, Correction which,
+               const GraphSolveOptions& o) {
+  const RowGroup& g = p.groups[static_cast<size_t>(gi)];
+  if (!active(p, g.island)) return;
+  Real max_delta = 0, max_lambda = 0;
+  for (std::int32_t k = g.begin; k < g.end; ++k) {
+    const ConstraintRow& r = p.rows[static_cast<size_t>(k)];
+    if (r.correction != which) continue;
+    Real& lambda = p.row_bias_lambda[static_cast<size_t>(k)];
+    const Real jv = rowVelocity(r, bodies[static_cast<size_t>(r.body_a)], bodies[static_cast<size_t>(r.body_b)]);
+    const Real delta = (r.bias_rhs - jv - r.cfm * lambda) * r.inv_diag;
+    const Real next = std::clamp(lambda + o.sor * delta, r.lo, r.hi);
+    const Real d = next - lambda;
+    lambda = next;
+    applyRow(r, bodies, o.dynamic_end, d);
+    max_delta = std::max(max_delta, std::abs(d));
+    max_lambda = std::max(max_lambda, std::abs(next));
+  }
+  p.group_delta[static_cast<size_t>(gi)] = max_delta;
+  p.group_lambda[static_cast<size_t>(gi)] = max_lambda;
+}
+
+// One sweep of a correction pass over a part, by colour: its row groups'
+// rows of kind `which` (with `groups`) and its manifolds' blocks (with
+// `contacts`, on `bodies` as sp says); returns whether any of the part's
+// islands goes on.
+bool biasSweep(GraphProblem& p, const Part& part, bool flow, std::span<SolverBody> bodies, Correction which,
+               bool contacts, bool groups, IslandFigures f, const ContactSweepParams& sp, const GraphSolveOptions& o,
+               int sweeps) {
+  double* body_data = bodies.front().v.data();
+  forColours(
+      p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end),
+      [&](std::int32_t gi) {
+        if (groups) biasGroup(p, gi, bodies, which, o);
+      },
+      [&](int b0, int b1) {
+        if (contacts) o.kernels->solve_bias(p.batches.data(), b0, b1, body_data, sp);
+      });
+  reduceSweep(p, f, part, contacts ? &ContactBatch::bias_delta : nullptr, &ContactBatch::bias_lambda, groups);
+  return stopConverged(f, part, o, sweeps);
+}
+
 // The passes of a sweep over a part's constraints.
 enum class Pass { WarmStart, Normals, Friction, Momentum };
 
@@ -367,8 +451,14 @@ bool usePipeline(GraphProblem& p, const GraphSolveOptions& o, bool flow) {
 
 // Warm start and the velocity sweeps of one part. `order` is this part's
 // own colour order (parts never randomize: the step makes none then).
+// With p.correction_swept, the split-impulse correction's sweeps on
+// `pseudo` too: each in the normal pass of a velocity sweep, the batch
+// visited for both at once, and alone past the velocity sweeps' end. Its
+// islands stop by its own figures (bias_active), and it reads nothing the
+// velocity sweeps write, so its bits are those of a pass of its own.
 GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::int32_t>& order,
-                          std::span<SolverBody> bodies, const GraphSolveOptions& o, std::uint64_t& rng_state) {
+                          std::span<SolverBody> bodies, std::span<SolverBody> pseudo, const GraphSolveOptions& o,
+                          std::uint64_t& rng_state) {
   GraphSolveStats stats;
   double* body_data = bodies.front().v.data();
   const bool flow = useFlow(p, o);
@@ -376,6 +466,15 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
   const bool overlap = pipeline || (flow && o.overlap_passes);
   const ContactSweepParams warm = sweepParams(p, o, false);
   const ContactSweepParams sp = sweepParams(p, o, o.nncg);
+  ContactSweepParams sp_bias = sweepParams(p, o, false);  // the correction alone
+  sp_bias.island_active = p.bias_active.data();
+  ContactSweepParams sp_both = sp;  // a velocity sweep's normal pass with the correction's
+  bool bias_on = p.correction_swept;
+  int bias_sweeps = 0;
+  if (bias_on) {
+    sp_both.pseudo = pseudo.front().v.data();
+    sp_both.pseudo_active = p.bias_active.data();
+  }
 
   const auto groupFn = [&](Pass pass) {
     return [&, pass](std::int32_t gi) {
@@ -398,7 +497,9 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
     return [&, pass](int b0, int b1) {
       switch (pass) {
         case Pass::WarmStart: o.kernels->warm_start(p.batches.data(), b0, b1, body_data, warm); break;
-        case Pass::Normals: o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, sp); break;
+        case Pass::Normals:
+          o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, bias_on ? sp_both : sp);
+          break;
         case Pass::Friction: o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); break;
         case Pass::Momentum:
           o.kernels->momentum(p.batches.data(), b0, b1, body_data, p.island_beta.data(), sp);
@@ -441,29 +542,51 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
     queue(Pass::Normals);
     if (batches) queue(Pass::Friction);  // a jointed scene without contacts has no friction pass
     endSweep();
-    reduceSweep(p, part, true);
+    reduceSweep(p, sweepFigures(p), part, &ContactBatch::sweep_delta, &ContactBatch::sweep_lambda, true);
+    if (bias_on) {
+      reduceSweep(p, fusedBiasFigures(p), part, &ContactBatch::bias_delta, &ContactBatch::bias_lambda, false);
+      bias_on = stopConverged(fusedBiasFigures(p), part, o, ++bias_sweeps);
+    }
     stats.last_max_delta = 0;
     for (std::int32_t i = part.island_begin; i < part.island_end; ++i)
       if (p.island_active[static_cast<size_t>(i)] > 0)
         stats.last_max_delta = std::max(stats.last_max_delta, p.island_delta[static_cast<size_t>(i)]);
     stats.iterations = it + 1;
-    if (!stopConverged(p, part, o, it + 1)) break;
+    if (!stopConverged(sweepFigures(p), part, o, it + 1)) break;
     // No momentum after the last sweep: the result must be a PGS iterate.
     if (o.nncg && it + 1 < o.iterations) {
       islandBetas(p, part);
       queue(Pass::Momentum);
     }
   }
+  // The correction's sweeps left when the velocities' stopped first (the
+  // momentum queued after a stopping sweep never runs: it was the last).
+  for (; bias_on && bias_sweeps < o.iterations;)
+    bias_on = biasSweep(p, part, flow, pseudo, Correction::PseudoVelocity, true, false, fusedBiasFigures(p), sp_bias, o,
+                        ++bias_sweeps);
   return stats;
 }
 
 }  // namespace
 
 GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const GraphSolveOptions& o,
-                           std::uint64_t& rng_state) {
+                           std::uint64_t& rng_state, std::span<SolverBody> pseudo) {
   GraphSolveStats stats;
+  p.correction_swept = false;
   if (p.empty()) return stats;
   startSweeps(p);
+  // The contacts' split-impulse correction with the velocity sweeps, where
+  // it is the whole pseudo-velocity pass (no row group has a pseudo row)
+  // and its colour order is the velocities' (not shuffled).
+  if (!pseudo.empty() && o.sweep_correction && !o.randomize_order && anyContactBias(p) &&
+      !anyRowBias(p, Correction::PseudoVelocity)) {
+    p.correction_swept = true;
+    clearBiasImpulses(p);
+    const size_t n = static_cast<size_t>(p.island_count);
+    p.bias_active.assign(n, 1.0);
+    p.bias_delta.assign(n, 0.0);
+    p.bias_lambda.assign(n, 0.0);
+  }
   if (o.nncg) {
     p.row_change.assign(p.rows.size(), Real(0));
     p.row_dir.assign(p.rows.size(), Real(0));
@@ -476,7 +599,8 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
   p.part_stats.assign(static_cast<size_t>(parts), GraphSolveStats{});
   p.part_order.resize(static_cast<size_t>(parts));
   forParts(p, o, [&](int k, const Part& part, const GraphSolveOptions& po) {
-    p.part_stats[static_cast<size_t>(k)] = sweepPart(p, part, p.part_order[static_cast<size_t>(k)], bodies, po, rng_state);
+    p.part_stats[static_cast<size_t>(k)] =
+        sweepPart(p, part, p.part_order[static_cast<size_t>(k)], bodies, pseudo, po, rng_state);
   });
   // The sweeps ended with the part that swept longest: its islands'
   // largest change is the last sweep's (as one part would report it).
@@ -488,64 +612,17 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
 
 namespace {
 
-// Something to correct: a push (bias > 0), or a pull on a row that can
-// pull (lo < 0). A negative bias on a one-sided row only permits approach.
-bool anyRowBias(const GraphProblem& p, Correction which) {
-  for (const ConstraintRow& r : p.rows)
-    if (r.correction == which && (r.bias_rhs > 0 || (r.bias_rhs < 0 && r.lo < 0))) return true;
-  return false;
-}
-
-bool anyContactBias(const GraphProblem& p) {
-  for (const ContactBatch& b : p.batches)
-    for (int i = 0; i < kMaxPoints; ++i)
-      for (int l = 0; l < kBatchLanes; ++l)
-        if (b.p[i].bias[l] > 0) return true;
-  return false;
-}
-
-void biasGroup(GraphProblem& p, std::int32_t gi, std::span<SolverBody> bodies, Correction which,
-               const GraphSolveOptions& o) {
-  const RowGroup& g = p.groups[static_cast<size_t>(gi)];
-  if (!active(p, g.island)) return;
-  Real max_delta = 0, max_lambda = 0;
-  for (std::int32_t k = g.begin; k < g.end; ++k) {
-    const ConstraintRow& r = p.rows[static_cast<size_t>(k)];
-    if (r.correction != which) continue;
-    Real& lambda = p.row_bias_lambda[static_cast<size_t>(k)];
-    const Real jv = rowVelocity(r, bodies[static_cast<size_t>(r.body_a)], bodies[static_cast<size_t>(r.body_b)]);
-    const Real delta = (r.bias_rhs - jv - r.cfm * lambda) * r.inv_diag;
-    const Real next = std::clamp(lambda + o.sor * delta, r.lo, r.hi);
-    const Real d = next - lambda;
-    lambda = next;
-    applyRow(r, bodies, o.dynamic_end, d);
-    max_delta = std::max(max_delta, std::abs(d));
-    max_lambda = std::max(max_lambda, std::abs(next));
-  }
-  p.group_delta[static_cast<size_t>(gi)] = max_delta;
-  p.group_lambda[static_cast<size_t>(gi)] = max_lambda;
-}
-
 // One correction pass (pgs.cpp's solvePgsCorrection, by colour and with
 // blocks for the contact normals), each island stopping on its own, each
 // part on its own thread.
 void biasPass(GraphProblem& p, std::span<SolverBody> bodies, Correction which, bool contacts,
               const GraphSolveOptions& o) {
   startSweeps(p);
-  double* body_data = bodies.front().v.data();
   const ContactSweepParams sp = sweepParams(p, o, false);
   forParts(p, o, [&](int, const Part& part, const GraphSolveOptions& po) {
     const bool flow = useFlow(p, po);
-    for (int it = 0; it < po.iterations; ++it) {
-      forColours(
-          p, flow, po.pool, std::views::iota(part.colour_begin, part.colour_end),
-          [&](std::int32_t gi) { biasGroup(p, gi, bodies, which, po); },
-          [&](int b0, int b1) {
-            if (contacts) po.kernels->solve_bias(p.batches.data(), b0, b1, body_data, sp);
-          });
-      reduceSweep(p, part, contacts);
-      if (!stopConverged(p, part, po, it + 1)) break;
-    }
+    for (int it = 0; it < po.iterations; ++it)
+      if (!biasSweep(p, part, flow, bodies, which, contacts, true, sweepFigures(p), sp, po, it + 1)) break;
   });
 }
 
@@ -556,11 +633,11 @@ bool solveGraphCorrection(GraphProblem& p, std::span<SolverBody> bodies, std::sp
   if (p.empty()) return false;
   p.row_bias_lambda.assign(p.rows.size(), Real(0));
   if (anyRowBias(p, Correction::VelocityBias)) biasPass(p, bodies, Correction::VelocityBias, false, o);
+  if (p.correction_swept) return true;  // swept with the velocities (solveGraph)
   const bool contacts = anyContactBias(p);
   if (!contacts && !anyRowBias(p, Correction::PseudoVelocity)) return false;
   std::fill(p.row_bias_lambda.begin(), p.row_bias_lambda.end(), Real(0));
-  for (ContactBatch& b : p.batches)
-    for (int i = 0; i < kMaxPoints; ++i) std::fill(std::begin(b.p[i].lambda_bias), std::end(b.p[i].lambda_bias), 0.0);
+  clearBiasImpulses(p);
   biasPass(p, pseudo, Correction::PseudoVelocity, contacts, o);
   return true;
 }

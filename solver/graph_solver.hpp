@@ -89,6 +89,10 @@ struct GraphProblem {
   std::vector<double> island_active;            // 1 while the island's sweeps go on
   std::vector<double> island_delta, island_lambda;
   std::vector<int> island_iterations;
+  // The split-impulse correction swept with the velocities (solveGraph's
+  // `pseudo`): whether it was, and its islands' own figures.
+  bool correction_swept = false;
+  std::vector<double> bias_active, bias_delta, bias_lambda;
   std::vector<std::vector<std::int32_t>> part_order;  // per part: its sweep's colour order
   std::vector<GraphSolveStats> part_stats;
   // One part with a pool: the colours' schedule without barriers
@@ -109,6 +113,7 @@ struct GraphProblem {
     part_island.clear();
     flow.reset();
     pipeline.reset();
+    correction_swept = false;
   }
   bool empty() const { return batches.empty() && groups.empty(); }
 };
@@ -128,17 +133,25 @@ struct GraphSolveOptions {
   // pass over every constraint before the next, the order that defines the
   // bits (the tests compare the two).
   bool overlap_passes = true;
+  // With solveGraph's `pseudo`, the contacts' split-impulse correction is
+  // swept with the velocities, each of its visits in a normal visit of the
+  // same batch (one read of the batch for both); false leaves it to
+  // solveGraphCorrection's pass of its own. The same bits either way.
+  bool sweep_correction = true;
 };
 
-// Warm start and the velocity sweeps.
+// Warm start and the velocity sweeps. Given `pseudo` (zeroed by the
+// caller), also the split-impulse correction where it is the contacts'
+// alone (GraphSolveOptions::sweep_correction), which
+// solveGraphCorrection then leaves out.
 GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const GraphSolveOptions& o,
-                           std::uint64_t& rng_state);
+                           std::uint64_t& rng_state, std::span<SolverBody> pseudo = {});
 
 // The position-correction passes from zero impulses: rows whose correction
 // is VelocityBias on `bodies`, then split-impulse rows (contact normals and
-// PseudoVelocity joint rows) on `pseudo` (zeroed by the caller). Returns
-// false when there was nothing to correct on the pseudo-velocities (then
-// they stay zero).
+// PseudoVelocity joint rows) on `pseudo` (zeroed by the caller before
+// solveGraph), unless solveGraph swept them. Returns false when there was
+// nothing to correct on the pseudo-velocities (then they stay zero).
 bool solveGraphCorrection(GraphProblem& p, std::span<SolverBody> bodies, std::span<SolverBody> pseudo,
                           const GraphSolveOptions& o);
 

@@ -117,9 +117,11 @@ void solveConstraints(WorldImpl& w, StepContext& ctx) {
   std::span<SolverBody> v(ctx.velocities);
   Real residual = 0;
 
-  // PGS islands, all at once over the coloured graph.
+  // PGS islands, all at once over the coloured graph; the contacts'
+  // split-impulse correction with them where it can be (graph_solver.hpp).
+  std::fill(ctx.pseudo.begin(), ctx.pseudo.end(), SolverBody{});
   if (!ctx.graph.empty()) {
-    const GraphSolveStats st = solveGraph(ctx.graph, v, o, w.rng_state_);
+    const GraphSolveStats st = solveGraph(ctx.graph, v, o, w.rng_state_, ctx.pseudo);
     w.stats_.iterations += st.iterations;
     if (s.compute_residual) {
       residual = std::max(residual, manifoldResidual(ctx.graph, v));
@@ -160,7 +162,6 @@ void solveConstraints(WorldImpl& w, StepContext& ctx) {
   // Correction): Baumgarte's bias velocities join the state; split
   // impulse's pseudo-velocities move the bodies this step but add no
   // momentum or kinetic energy.
-  std::fill(ctx.pseudo.begin(), ctx.pseudo.end(), SolverBody{});
   ctx.has_pseudo = solveGraphCorrection(ctx.graph, v, ctx.pseudo, o);
   if (!ctx.rows.empty()) {
     PgsSettings ps{s.iterations, s.tolerance, s.sor, false, s.seed};

@@ -296,6 +296,86 @@ TEST(Determinism, OverlappedPassesGiveTheBitsOfPassAfterPass) {
   expectOverlapGivesTheBitsOfPassAfterPass(large, &pool, Overlap::FlowInterleaved);
 }
 
+// A pyramid whose rows sink 3 cm into each other and the bottom row 3 cm
+// into the ground (past the 5 mm slop), so that every contact has a
+// split-impulse correction target at the first step.
+SceneDesc sunkenPyramid(int n) {
+  SceneDesc s = scenarios::pyramid(n);
+  for (BodyDef& b : s.bodies)
+    if (b.mass > 0) b.position.y() -= Real(0.03) * (b.position.y() + Real(0.5));
+  return s;
+}
+
+// Solves the graph of the first step of `s` (on `pool`) twice from the
+// same state: its split-impulse correction swept with the velocities, and
+// in a pass of its own after them; compares the pseudo-velocities, the
+// correction impulses and the velocities with ==. `tolerance` lets the
+// velocity sweeps stop before the correction's, so that the correction
+// also sweeps alone after them (asserted).
+void expectSweptCorrectionGivesTheBitsOfItsOwnPass(const SceneDesc& s, WorkerPool* pool, Real tolerance) {
+  World w = buildWorld(s);
+  w.step(s.dt);
+  const detail::StepContext& ctx = detail::internals(w).stepContext();
+  GraphSolveOptions o;
+  o.dynamic_end = ctx.dynamic_count + 1;
+  o.kernels = &contactKernels(bestSimdLevel());
+  o.pool = pool;
+  o.tolerance = tolerance;
+  GraphProblem swept = ctx.graph, own = ctx.graph;
+  for (GraphProblem* g : {&swept, &own}) {
+    g->pipeline.reset();
+    g->flow.reset();
+  }
+  std::vector<SolverBody> v_swept = ctx.velocities, v_own = ctx.velocities;
+  std::vector<SolverBody> p_swept(ctx.velocities.size()), p_own(ctx.velocities.size());
+  std::uint64_t rng = 1;
+  solveGraph(swept, v_swept, o, rng, p_swept);
+  EXPECT_TRUE(solveGraphCorrection(swept, v_swept, p_swept, o));
+  o.sweep_correction = false;
+  const GraphSolveStats velocity = solveGraph(own, v_own, o, rng, p_own);
+  EXPECT_TRUE(solveGraphCorrection(own, v_own, p_own, o));
+  ASSERT_TRUE(swept.correction_swept);
+  ASSERT_FALSE(own.correction_swept);
+  if (tolerance > 0) {  // the correction's own pass swept longer than the velocities
+    const int correction = *std::max_element(own.island_iterations.begin(), own.island_iterations.end());
+    ASSERT_GT(correction, velocity.iterations);
+  }
+  for (size_t i = 0; i < v_own.size(); ++i) {
+    EXPECT_EQ(p_swept[i].v, p_own[i].v) << "body " << i;
+    EXPECT_EQ(p_swept[i].w, p_own[i].w) << "body " << i;
+    EXPECT_EQ(v_swept[i].v, v_own[i].v) << "body " << i;
+    EXPECT_EQ(v_swept[i].w, v_own[i].w) << "body " << i;
+  }
+  int differ = 0, pushing = 0;
+  for (size_t b = 0; b < own.batches.size(); ++b)
+    for (int i = 0; i < kMaxPoints; ++i)
+      for (int l = 0; l < kBatchLanes; ++l) {
+        differ += swept.batches[b].p[i].lambda_bias[l] != own.batches[b].p[i].lambda_bias[l];
+        pushing += own.batches[b].p[i].lambda_bias[l] > 0;
+      }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(pushing, 0);
+}
+
+// The contacts' split-impulse correction is swept with the velocities,
+// each of its block visits in the normal visit of the same batch
+// (GraphSolveOptions::sweep_correction). It reads nothing the velocity
+// sweeps write and keeps its colour order and its own stopping test, so
+// its pseudo-velocities must be those of its own pass, bit for bit: on one
+// thread (interleaved passes, base 30), side by side on two (base 30),
+// by the flow schedule (base 60), and where it sweeps on alone after the
+// velocity sweeps stop (a tolerance).
+TEST(Determinism, CorrectionSweptWithTheVelocitiesGivesTheBitsOfItsOwnPass) {
+  WorkerPool pool(2);
+  expectSweptCorrectionGivesTheBitsOfItsOwnPass(sunkenPyramid(30), nullptr, 0);
+  expectSweptCorrectionGivesTheBitsOfItsOwnPass(sunkenPyramid(30), &pool, 0);
+  expectSweptCorrectionGivesTheBitsOfItsOwnPass(sunkenPyramid(60), &pool, 0);
+  // 1 cm/s: the velocity sweeps stop after 4 of the 10 (base 30), the
+  // correction's after 10.
+  expectSweptCorrectionGivesTheBitsOfItsOwnPass(sunkenPyramid(30), nullptr, Real(1e-2));
+  expectSweptCorrectionGivesTheBitsOfItsOwnPass(sunkenPyramid(60), &pool, Real(1e-2));
+}
+
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {
   const SceneDesc s = scenarios::pyramid(10);
   const auto portable = run(s, kSteps, 1, Simd::Portable);

@@ -396,6 +396,50 @@ struct Kernel {
     }
   }
 
+  // One projected Gauss-Seidel visit of lanes [o, o + W)'s normal blocks on
+  // the velocities v (the bodies' or the correction's pseudo-velocities),
+  // from the impulses in `impulse` toward the targets in `target`: the
+  // velocity pass and the correction pass differ only in these and in what
+  // they record, which `record(point, new impulse, change)` does per point.
+  // The lanes' largest change and impulse grow maxd and maxl.
+  using PointLanes = ContactBatch::Lanes ContactBatch::Point::*;
+  template <class Record>
+  CAIRN_INLINE void blockVisit(ContactBatch& b, int o, double* v, PointLanes impulse, PointLanes target, int dynamic_end,
+                               D sor, M active, D& maxd, D& maxl, Record&& record) {
+    Pair s;
+    gather(v, b, o, s);
+    const Mass m = loadMass(b, o);
+    const V3 n = ld3(b.n, o);
+    const D cfm = ld(b.cfm + o);
+    D res[4], lam[4], valid[4], inv_diag[4], dd[4];
+    const D n_dv = dot(n, sub(s.vb, s.va));
+    for (int i = 0; i < 4; ++i) {
+      const ContactBatch::Point& q = b.p[i];
+      valid[i] = ld(q.valid + o);
+      lam[i] = ld(q.*impulse + o);
+      inv_diag[i] = ld(q.normal_mass + o);
+      const D jv = n_dv + dot(ld3(q.rbn, o), s.wb) - dot(ld3(q.ran, o), s.wa);
+      res[i] = (ld(q.*target + o) - jv) * valid[i];
+    }
+    solveBlock(b, o, res, lam, valid, cfm, sor, inv_diag, dd);
+    D total = zero();
+    V3 ta = zero3(), tb = zero3();
+    for (int i = 0; i < 4; ++i) {
+      ContactBatch::Point& q = b.p[i];
+      dd[i] = sel(active, dd[i], zero());
+      lam[i] = sel(active, lam[i], ld(q.*impulse + o));
+      total += dd[i];
+      ta = add(ta, mul(ld3(q.ran, o), dd[i]));
+      tb = add(tb, mul(ld3(q.rbn, o), dd[i]));
+      st(q.*impulse + o, lam[i]);
+      record(q, lam[i], dd[i]);
+      maxd = vmax(maxd, vabs(dd[i]));
+      maxl = vmax(maxl, lam[i]);
+    }
+    applySum(s, m, Sum{mul(n, total), ta, tb});
+    scatter(v, b, o, s, dynamic_end, active);
+  }
+
   // One projected Gauss-Seidel visit of every manifold's normal block.
   static void solveNormals(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p) {
     const D sor = splat(p.sor);
@@ -409,47 +453,18 @@ struct Kernel {
         }
         const M active = activeLanes(b, o, p.island_active);
         if (!any(active)) continue;
-        Pair s;
-        gather(bodies, b, o, s);
-        const Mass m = loadMass(b, o);
-        const V3 n = ld3(b.n, o);
-        const D cfm = ld(b.cfm + o);
         D maxd = zero(), maxl = zero(), ch2 = zero();
-        D res[4], lam[4], valid[4], inv_diag[4], dd[4];
-        const V3 dv = sub(s.vb, s.va);
-        const D n_dv = dot(n, dv);
-        for (int i = 0; i < 4; ++i) {
-          const ContactBatch::Point& q = b.p[i];
-          valid[i] = ld(q.valid + o);
-          lam[i] = ld(q.lambda + o);
-          inv_diag[i] = ld(q.normal_mass + o);
-          const D jv = n_dv + dot(ld3(q.rbn, o), s.wb) - dot(ld3(q.ran, o), s.wa);
-          res[i] = (ld(q.rhs + o) - jv) * valid[i];
-        }
-        solveBlock(b, o, res, lam, valid, cfm, sor, inv_diag, dd);
-        D total = zero();
-        V3 ta = zero3(), tb = zero3();
-        for (int i = 0; i < 4; ++i) {
-          ContactBatch::Point& q = b.p[i];
-          dd[i] = sel(active, dd[i], zero());
-          lam[i] = sel(active, lam[i], ld(q.lambda + o));
-          total += dd[i];
-          ta = add(ta, mul(ld3(q.ran, o), dd[i]));
-          tb = add(tb, mul(ld3(q.rbn, o), dd[i]));
-          st(q.lambda + o, lam[i]);
-          st(q.max_lambda + o, vmax(ld(q.max_lambda + o), lam[i]));
-          maxd = vmax(maxd, vabs(dd[i]));
-          maxl = vmax(maxl, lam[i]);
-          if (p.gather_change) {
-            st(q.change_n + o, dd[i]);
-            ch2 += dd[i] * dd[i];
-          }
-        }
-        applySum(s, m, Sum{mul(n, total), ta, tb});
+        blockVisit(b, o, bodies, &ContactBatch::Point::lambda, &ContactBatch::Point::rhs, p.dynamic_end, sor, active, maxd,
+                   maxl, [&](ContactBatch::Point& q, D lam, D dd) {
+                     st(q.max_lambda + o, vmax(ld(q.max_lambda + o), lam));
+                     if (p.gather_change) {
+                       st(q.change_n + o, dd);
+                       ch2 += dd * dd;
+                     }
+                   });
         if (p.gather_change) st(b.change2 + o, ch2);
         st(b.sweep_delta + o, maxd);
         st(b.sweep_lambda + o, maxl);
-        scatter(bodies, b, o, s, p.dynamic_end, active);
       }
     }
   }
@@ -567,39 +582,11 @@ struct Kernel {
   // targets, on the pseudo-velocities, from lambda_bias; the lanes' largest
   // change and impulse go to bias_delta and bias_lambda.
   CAIRN_INLINE void biasLanes(ContactBatch& b, int o, double* pseudo, const ContactSweepParams& p, D sor, M active) {
-    Pair s;
-    gather(pseudo, b, o, s);
-    const Mass m = loadMass(b, o);
-    const V3 n = ld3(b.n, o);
-    const D cfm = ld(b.cfm + o);
-    D res[4], lam[4], valid[4], inv_diag[4], dd[4];
-    const D n_dv = dot(n, sub(s.vb, s.va));
-    for (int i = 0; i < 4; ++i) {
-      const ContactBatch::Point& q = b.p[i];
-      valid[i] = ld(q.valid + o);
-      lam[i] = ld(q.lambda_bias + o);
-      inv_diag[i] = ld(q.normal_mass + o);
-      const D jv = n_dv + dot(ld3(q.rbn, o), s.wb) - dot(ld3(q.ran, o), s.wa);
-      res[i] = (ld(q.bias + o) - jv) * valid[i];
-    }
-    solveBlock(b, o, res, lam, valid, cfm, sor, inv_diag, dd);
-    D total = zero(), maxd = zero(), maxl = zero();
-    V3 ta = zero3(), tb = zero3();
-    for (int i = 0; i < 4; ++i) {
-      ContactBatch::Point& q = b.p[i];
-      dd[i] = sel(active, dd[i], zero());
-      lam[i] = sel(active, lam[i], ld(q.lambda_bias + o));
-      total += dd[i];
-      ta = add(ta, mul(ld3(q.ran, o), dd[i]));
-      tb = add(tb, mul(ld3(q.rbn, o), dd[i]));
-      st(q.lambda_bias + o, lam[i]);
-      maxd = vmax(maxd, vabs(dd[i]));
-      maxl = vmax(maxl, lam[i]);
-    }
-    applySum(s, m, Sum{mul(n, total), ta, tb});
+    D maxd = zero(), maxl = zero();
+    blockVisit(b, o, pseudo, &ContactBatch::Point::lambda_bias, &ContactBatch::Point::bias, p.dynamic_end, sor, active,
+               maxd, maxl, [](ContactBatch::Point&, D, D) {});
     st(b.bias_delta + o, maxd);
     st(b.bias_lambda + o, maxl);
-    scatter(pseudo, b, o, s, p.dynamic_end, active);
   }
 
   static void solveBias(ContactBatch* batches, int begin, int end, double* pseudo, const ContactSweepParams& p) {

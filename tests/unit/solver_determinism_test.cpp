@@ -233,24 +233,39 @@ TEST(Determinism, MidSizedPyramidRunsItsPassesSideBySideAndIsBitIdentical) {
   }
 }
 
+// Two copies of the graph the step left in `w`, and of its velocities, to
+// solve two ways from the same state, with the step's options (on `pool`).
+// Their plans (pass pipeline, flow schedule) are reset, so that each solve
+// makes its own.
+struct TwoSolves {
+  GraphSolveOptions options;
+  GraphProblem graph[2];
+  std::vector<SolverBody> velocities[2];
+  TwoSolves(const World& w, WorkerPool* pool) {
+    const detail::StepContext& ctx = detail::internals(w).stepContext();
+    options.dynamic_end = ctx.dynamic_count + 1;
+    options.kernels = &contactKernels(bestSimdLevel());
+    options.pool = pool;
+    for (int k = 0; k < 2; ++k) {
+      graph[k] = ctx.graph;
+      graph[k].pipeline.reset();
+      graph[k].flow.reset();
+      velocities[k] = ctx.velocities;
+    }
+  }
+};
+
 // Solves the graph the step left in `w` twice from the same state, its
 // passes overlapped and pass after pass, and compares the impulses and
 // velocities with ==.
 enum class Overlap { Interleaved, SideBySide, FlowInterleaved };
 void expectOverlapGivesTheBitsOfPassAfterPass(const World& w, WorkerPool* pool, Overlap overlap) {
-  const detail::StepContext& ctx = detail::internals(w).stepContext();
   for (const bool nncg : {true, false}) {
-    GraphSolveOptions o;
+    TwoSolves two(w, pool);
+    GraphSolveOptions& o = two.options;
     o.nncg = nncg;
-    o.dynamic_end = ctx.dynamic_count + 1;
-    o.kernels = &contactKernels(bestSimdLevel());
-    o.pool = pool;
-    GraphProblem overlapped = ctx.graph, in_turn = ctx.graph;
-    for (GraphProblem* g : {&overlapped, &in_turn}) {
-      g->pipeline.reset();
-      g->flow.reset();
-    }
-    std::vector<SolverBody> v_overlapped = ctx.velocities, v_in_turn = ctx.velocities;
+    GraphProblem &overlapped = two.graph[0], &in_turn = two.graph[1];
+    std::vector<SolverBody> &v_overlapped = two.velocities[0], &v_in_turn = two.velocities[1];
     std::uint64_t rng = 1;
     solveGraph(overlapped, v_overlapped, o, rng);
     o.overlap_passes = false;
@@ -315,19 +330,12 @@ SceneDesc sunkenPyramid(int n) {
 void expectSweptCorrectionGivesTheBitsOfItsOwnPass(const SceneDesc& s, WorkerPool* pool, Real tolerance) {
   World w = buildWorld(s);
   w.step(s.dt);
-  const detail::StepContext& ctx = detail::internals(w).stepContext();
-  GraphSolveOptions o;
-  o.dynamic_end = ctx.dynamic_count + 1;
-  o.kernels = &contactKernels(bestSimdLevel());
-  o.pool = pool;
+  TwoSolves two(w, pool);
+  GraphSolveOptions& o = two.options;
   o.tolerance = tolerance;
-  GraphProblem swept = ctx.graph, own = ctx.graph;
-  for (GraphProblem* g : {&swept, &own}) {
-    g->pipeline.reset();
-    g->flow.reset();
-  }
-  std::vector<SolverBody> v_swept = ctx.velocities, v_own = ctx.velocities;
-  std::vector<SolverBody> p_swept(ctx.velocities.size()), p_own(ctx.velocities.size());
+  GraphProblem &swept = two.graph[0], &own = two.graph[1];
+  std::vector<SolverBody> &v_swept = two.velocities[0], &v_own = two.velocities[1];
+  std::vector<SolverBody> p_swept(v_own.size()), p_own(v_own.size());
   std::uint64_t rng = 1;
   solveGraph(swept, v_swept, o, rng, p_swept);
   EXPECT_TRUE(solveGraphCorrection(swept, v_swept, p_swept, o));

@@ -12,10 +12,12 @@
 // Per manifold only what the solver reads, in the spirit of Box2D v3's
 // b2ContactConstraintSIMD and Bullet's btSolverConstraint: the two bodies,
 // their inverse masses and world inverse inertias (constant over the step),
-// the normal, and per point the angular parts of its rows' Jacobians (r_a x
-// u and r_b x u for the normal and the two tangents), the effective masses,
-// targets and impulses. M^-1 J^T is formed on the fly from the inverse
-// masses, which the kernel holds in registers for the whole manifold:
+// the normal, and per point the angular parts of its normal row's Jacobian
+// (r_a x n and r_b x n), the anchors r_a and r_b (the tangent rows' r x t
+// are formed from them on the fly: on a large scene the sweeps wait on
+// memory, not on arithmetic), the effective masses, targets and impulses.
+// M^-1 J^T is formed on the fly from the inverse masses, which the kernel
+// holds in registers for the whole manifold:
 //
 //   J v   = u . (v_b - v_a) + (r_b x u) . w_b - (r_a x u) . w_a
 //   dv_a  = -m_a^-1 u dl,   dw_a = -I_a^-1 (r_a x u) dl   (and + for b)
@@ -55,7 +57,11 @@ struct alignas(64) ContactBatch {
     Lanes valid;            // 1 for a point in use, 0 for padding
     Lanes ran[3], rbn[3];   // r_a x n and r_b x n (anchors from the centers of mass, world)
     Lanes t[3];             // first tangent (the second is n x t)
-    Lanes rat[2][3], rbt[2][3];  // r_a x t_k and r_b x t_k
+    // r_a and r_b, the anchors from the centers of mass (world; zeros where
+    // no tangent row is solved): the tangent rows' angular parts r x t_k
+    // are formed from them on the fly, six numbers per point read instead
+    // of twelve (Box2D v3's b2ContactConstraintPoint keeps the anchors too).
+    Lanes ra[3], rb[3];
     Lanes rhs;              // velocity target of the normal row
     Lanes normal_mass;      // 1 / (A_ii + cfm)
     Lanes tangent_mass[2];  // 1 / (A_tt + cfm) for t and n x t

@@ -384,11 +384,13 @@ struct Kernel {
         for (int i = 0; i < points; ++i) {
           const ContactBatch::Point& q = b.p[i];
           addRow(sum, n, ld3(q.ran, o), ld3(q.rbn, o), ld(q.lambda + o));
-          const V3 t1 = ld3(q.t, o);
+          const V3 t1 = ld3(q.t, o), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
           // The tangent rows in use (a row past friction_rows holds zeros: it would add nothing).
-          addRow(sum, t1, ld3(q.rat[0], o), ld3(q.rbt[0], o), ld(q.lambda_t[0] + o));
-          if (p.friction_rows > 1)
-            addRow(sum, cross(n, t1), ld3(q.rat[1], o), ld3(q.rbt[1], o), ld(q.lambda_t[1] + o));
+          addRow(sum, t1, cross(ra, t1), cross(rb, t1), ld(q.lambda_t[0] + o));
+          if (p.friction_rows > 1) {
+            const V3 t2 = cross(n, t1);
+            addRow(sum, t2, cross(ra, t2), cross(rb, t2), ld(q.lambda_t[1] + o));
+          }
         }
         applySum(s, m, sum);
         scatter(bodies, b, o, s, p.dynamic_end, allTrue());
@@ -494,11 +496,11 @@ struct Kernel {
         D ch2 = p.gather_change ? ld(b.change2 + o) : zero();
         for (int i = 0; i < points; ++i) {
           ContactBatch::Point& q = b.p[i];
-          const V3 t1 = ld3(q.t, o);
+          const V3 t1 = ld3(q.t, o), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
           const D limit = mu * ld(q.lambda + o);
           for (int k = 0; k < p.friction_rows; ++k) {
             const V3 u = k == 0 ? t1 : cross(n, t1);
-            const V3 ra_u = ld3(q.rat[k], o), rb_u = ld3(q.rbt[k], o);
+            const V3 ra_u = cross(ra, u), rb_u = cross(rb, u);
             const D l = ld(q.lambda_t[k] + o);
             D next = l + sor * (-rowVel(s, u, ra_u, rb_u) - cfm * l) * ld(q.tangent_mass[k] + o);
             next = vmin(vmax(next, -limit), limit);
@@ -562,14 +564,15 @@ struct Kernel {
           st(q.max_lambda + o, vmax(ld(q.max_lambda + o), ln));
           st(q.dir_n + o, newDir(dir, ld(q.change_n + o)));
           addRow(sum, n, ld3(q.ran, o), ld3(q.rbn, o), ln - l);
-          const V3 t1 = ld3(q.t, o);
+          const V3 t1 = ld3(q.t, o), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
           const D limit = mu * ln;
           for (int k = 0; k < p.friction_rows; ++k) {  // a row past them stays zero
             const D lt = ld(q.lambda_t[k] + o), dt = ld(q.dir_t[k] + o);
             const D next = sel(apply, vmin(vmax(lt + bstep * dt, -limit), limit), lt);
             st(q.lambda_t[k] + o, next);
             st(q.dir_t[k] + o, newDir(dt, ld(q.change_t[k] + o)));
-            addRow(sum, k == 0 ? t1 : cross(n, t1), ld3(q.rat[k], o), ld3(q.rbt[k], o), next - lt);
+            const V3 u = k == 0 ? t1 : cross(n, t1);
+            addRow(sum, u, cross(ra, u), cross(rb, u), next - lt);
           }
         }
         applySum(s, m, sum);
@@ -826,12 +829,19 @@ struct Kernel {
         // residual, the statistics and the exported rows skip it).
         const M rubs = ok & (mu > 0);
         const auto rowPut = [&](double* dst, D v) { st(dst + o, sel(rubs, v, zero_)); };
+        const auto anchorPut = [&](double (*dst)[kBatchLanes], const V3& v) {  // zeros where no tangent row is solved
+          if (p.friction_rows > 0) {
+            rowPut(dst[0], v.x);
+            rowPut(dst[1], v.y);
+            rowPut(dst[2], v.z);
+          } else {
+            st3(dst, o, zero3());
+          }
+        };
+        anchorPut(q.ra, ra);
+        anchorPut(q.rb, rb);
         for (int k2 = 0; k2 < 2; ++k2) {
           if (k2 >= p.friction_rows) {  // not solved: zeros, nothing computed
-            for (int c = 0; c < 3; ++c) {
-              st(q.rat[k2][c] + o, zero_);
-              st(q.rbt[k2][c] + o, zero_);
-            }
             st(q.tangent_mass[k2] + o, zero_);
             st(q.lambda_t[k2] + o, zero_);
             continue;
@@ -839,12 +849,6 @@ struct Kernel {
           const V3 t = k2 == 0 ? t1 : cross(n, t1);
           const V3 rat = cross(ra, t), rbt = cross(rb, t);
           const D kt = dot(t, cmul(m_ab, t)) + dot(rat, mulM(ia, rat)) + dot(rbt, mulM(ib, rbt));
-          rowPut(q.rat[k2][0], rat.x);
-          rowPut(q.rat[k2][1], rat.y);
-          rowPut(q.rat[k2][2], rat.z);
-          rowPut(q.rbt[k2][0], rbt.x);
-          rowPut(q.rbt[k2][1], rbt.y);
-          rowPut(q.rbt[k2][2], rbt.z);
           rowPut(q.tangent_mass[k2], kt + cfm);  // inverted with the batch (<= 0: no row)
           rowPut(q.lambda_t[k2], splat(p.warm) * dot(fi, t));
         }

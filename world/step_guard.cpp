@@ -70,7 +70,7 @@ const char* badLaneField(const ContactBatch& b, int l) {
   for (int i = 0; i < kMaxPoints; ++i) {
     const ContactBatch::Point& p = b.p[i];
     for (int k = 0; k < 3; ++k)
-      point += p.ran[k][l] + p.rbn[k][l] + p.t[k][l] + p.rat[0][k][l] + p.rat[1][k][l] + p.rbt[0][k][l] + p.rbt[1][k][l];
+      point += p.ran[k][l] + p.rbn[k][l] + p.t[k][l] + p.ra[k][l] + p.rb[k][l];
     point += p.rhs[l] + p.bias[l] + p.normal_mass[l] + p.tangent_mass[0][l] + p.tangent_mass[1][l];
   }
   if (!std::isfinite(point)) return "anchor, target or effective mass";

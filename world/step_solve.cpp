@@ -60,7 +60,8 @@ LaneRow laneRowParts(const ContactBatch& b, int l, int i, int row) {  // row 0: 
   const Vec3 n = v3(b.n);
   if (row == 0) return {n, v3(q.ran), v3(q.rbn)};
   const Vec3 t1 = v3(q.t);
-  return {row == 1 ? t1 : Vec3(n.cross(t1)), v3(q.rat[row - 1]), v3(q.rbt[row - 1])};
+  const Vec3 u = row == 1 ? t1 : Vec3(n.cross(t1));
+  return {u, v3(q.ra).cross(u), v3(q.rb).cross(u)};  // as the kernels form them
 }
 
 // The natural-map residual of the manifolds (solver/lcp_residual.hpp's

@@ -829,17 +829,9 @@ struct Kernel {
         // residual, the statistics and the exported rows skip it).
         const M rubs = ok & (mu > 0);
         const auto rowPut = [&](double* dst, D v) { st(dst + o, sel(rubs, v, zero_)); };
-        const auto anchorPut = [&](double (*dst)[kBatchLanes], const V3& v) {  // zeros where no tangent row is solved
-          if (p.friction_rows > 0) {
-            rowPut(dst[0], v.x);
-            rowPut(dst[1], v.y);
-            rowPut(dst[2], v.z);
-          } else {
-            st3(dst, o, zero3());
-          }
-        };
-        anchorPut(q.ra, ra);
-        anchorPut(q.rb, rb);
+        // The anchors, for the tangent rows' r x t: zeros where no tangent row is solved.
+        st3(q.ra, o, p.friction_rows > 0 ? sel3(rubs, ra, zero3()) : zero3());
+        st3(q.rb, o, p.friction_rows > 0 ? sel3(rubs, rb, zero3()) : zero3());
         for (int k2 = 0; k2 < 2; ++k2) {
           if (k2 >= p.friction_rows) {  // not solved: zeros, nothing computed
             st(q.tangent_mass[k2] + o, zero_);

@@ -16,6 +16,9 @@
 //       a change to a kernel must show to reach the step.
 //   BM_JointRowUpdate   the same over the joint rows of chain-100 after 30
 //       steps (mid-whip), each joint's rows in order.
+//   BM_JointLanes/scene:S/lanes:L   the joints of many chains (S = 0) or
+//       ragdolls (S = 1) side by side, solved in the kernels' lanes (L = 1)
+//       or each alone (L = 0); its comment below has the scenes.
 //
 // The time is the thread's CPU time around the sweeps only (manual time):
 // a loaded machine that deschedules the thread does not inflate it, but it
@@ -47,8 +50,7 @@ struct Captured {
   double contact_rows = 0, joint_rows = 0;
 };
 
-Captured capture(const char* scene_name, int steps) {
-  SceneDesc scene = scenarios::byName(scene_name);
+Captured capture(SceneDesc scene, int steps) {
   scene.solver.sleeping = false;
   // The graph holds the PGS islands only: auto's default would give
   // chain-100 to the direct solver and leave no joint rows to time.
@@ -74,7 +76,7 @@ void BM_ContactRowUpdate(benchmark::State& state) {
     state.SkipWithError("instruction set not available here");
     return;
   }
-  static const Captured problem = capture("pyramid-20", 60);
+  static const Captured problem = capture(scenarios::byName("pyramid-20"), 60);
   if (problem.contact_rows == 0) {  // a figure over no rows would read as a time per row
     state.SkipWithError("pyramid-20 left no contact rows in the PGS graph");
     return;
@@ -145,7 +147,7 @@ void BM_ContactSolve(benchmark::State& state) {
     state.SkipWithError("instruction set not available here");
     return;
   }
-  static const Captured problem = capture("pyramid-20", 60);
+  static const Captured problem = capture(scenarios::byName("pyramid-20"), 60);
   if (problem.contact_rows == 0) {
     state.SkipWithError("pyramid-20 left no contact rows in the PGS graph");
     return;
@@ -162,7 +164,7 @@ void BM_ContactSolve(benchmark::State& state) {
 BENCHMARK(BM_ContactSolve)->ArgName("simd")->DenseRange(0, 2)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
 void BM_JointRowUpdate(benchmark::State& state) {
-  static const Captured problem = capture("chain-100", 30);
+  static const Captured problem = capture(scenarios::byName("chain-100"), 30);
   if (problem.joint_rows == 0) {
     state.SkipWithError("chain-100 left no joint rows in the PGS graph");
     return;
@@ -180,6 +182,42 @@ void BM_JointRowUpdate(benchmark::State& state) {
   state.counters["colours"] = static_cast<double>(g.colours.size());
 }
 BENCHMARK(BM_JointRowUpdate)->UseManualTime()->Unit(benchmark::kMicrosecond);
+
+// Joints side by side (solver/joint_lanes.hpp): the velocity sweeps, as
+// BM_JointRowUpdate, over scenes whose colours hold many joints, with the
+// joints of a colour in the kernels' lanes (lanes:1) or each alone
+// (lanes:0), the same bits either way (tested):
+//   scene:0  32 chains of 20 ball-jointed links side by side, after 30 steps
+//            (every colour 32 ball joints of three rows);
+//   scene:1  16 ragdolls side by side on the ground, after 60 steps (hinges
+//            and cone-twists with their limits: colours of mixed row
+//            counts, contacts beside them).
+void BM_JointLanes(benchmark::State& state) {
+  static const Captured chains = capture(scenarios::sideBySide(scenarios::chain(20), 32, Vec3(0, 0, 0.5)), 30);
+  static const Captured ragdolls = capture(scenarios::sideBySide(scenarios::byName("ragdoll"), 16, Vec3(2.5, 0, 0)), 60);
+  const Captured& problem = state.range(0) == 0 ? chains : ragdolls;
+  constexpr int kSweeps = 10;
+  GraphProblem g = problem.graph;
+  GraphSolveOptions o;
+  o.iterations = kSweeps;
+  o.nncg = false;
+  o.dynamic_end = problem.dynamic_end;
+  o.kernels = &contactKernels(bestSimdLevel());
+  o.joint_lanes = state.range(1) != 0;
+  state.SetLabel(o.kernels->name);
+  timeSolveGraph(state, g, problem.velocities, problem.joint_rows + problem.contact_rows, o,
+                 [&](GraphProblem& p) {
+                   p = problem.graph;
+                   for (ConstraintRow& r : p.rows) r.lambda = 0;  // cold: every sweep works
+                 });
+  state.counters["joint_rows"] = problem.joint_rows;
+  state.counters["lanes"] = static_cast<double>(g.joint_lanes.size());
+}
+BENCHMARK(BM_JointLanes)
+    ->ArgNames({"scene", "lanes"})
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace cairn::bench

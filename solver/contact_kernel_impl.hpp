@@ -856,15 +856,22 @@ struct Kernel {
   }
 };
 
+#include "solver/joint_kernel_impl.hpp"
+
 #undef CAIRN_INLINE
 
 }  // namespace
 
-// The table of this unit's kernels.
-inline ContactKernels makeKernels(const char* name) {
+// The table of this unit's kernels, a constant: a table filled at run time
+// would be filled by this unit's instructions, before the CPU is asked
+// what it supports (the units define it constinit).
+constexpr ContactKernels makeKernels(const char* name) {
   using K = Kernel<CAIRN_KERNEL_LANES>;
-  return ContactKernels{name,          CAIRN_KERNEL_LANES, &K::warmStart, &K::solveNormals, &K::solveFriction,
-                        &K::momentum,  &K::solveBias,      &K::restitution, &K::fill};
+  return ContactKernels{name,         CAIRN_KERNEL_LANES, &K::warmStart,   &K::solveNormals,
+                        &K::solveFriction, &K::momentum, &K::solveBias, &K::restitution,
+                        &K::fill,     &JointKernel<CAIRN_KERNEL_LANES>::solveLanes,
+                        &JointKernel<CAIRN_KERNEL_LANES>::momentumLanes,
+                        &JointKernel<CAIRN_KERNEL_LANES>::biasLanes};
 }
 
 }  // namespace CAIRN_KERNEL_NS

@@ -1,5 +1,6 @@
-// The contact solver's inner loops, one set per instruction set: portable
-// (one lane at a time, any CPU), AVX2 (four doubles) and AVX-512 (eight).
+// The contact solver's inner loops (and the joints' lanes, joint_lanes.hpp),
+// one set per instruction set: portable (one lane at a time, any CPU), AVX2
+// (four doubles) and AVX-512 (eight).
 // Each set is compiled in its own translation unit with its own target
 // flags (solver/contact_kernels_*.cpp) from the one template in
 // contact_kernel_impl.hpp; the engine picks a set at run time from what the
@@ -14,6 +15,7 @@
 #pragma once
 
 #include "solver/contact_batch.hpp"
+#include "solver/joint_lanes.hpp"
 
 namespace cairn {
 
@@ -53,6 +55,19 @@ struct ContactKernels {
   // body_b, island and count are already set; the Cholesky factor and the
   // inverted effective masses are the step's, after this).
   void (*fill)(ContactBatch& batch, const ContactBatchInput& in, const ContactFillParams& p);
+  // One projected Gauss-Seidel visit of the joints in the lanes of
+  // lanes[begin, end) (joint_lanes.hpp), each joint's rows in order, with
+  // the bits of each joint's scalar visit; and NNCG's momentum step on
+  // them (with beta per island, as `momentum`); and a correction pass's
+  // visit of their rows whose Correction is `which`, toward bias_rhs from
+  // lambda_bias. Use sor, dynamic_end, gather_change and island_active of
+  // `p`.
+  void (*solve_joint_lanes)(JointLanes* lanes, JointLaneRow* rows, int begin, int end, double* bodies,
+                            const ContactSweepParams& p);
+  void (*joint_lanes_momentum)(JointLanes* lanes, JointLaneRow* rows, int begin, int end, double* bodies,
+                               const double* island_beta, const ContactSweepParams& p);
+  void (*joint_lanes_bias)(JointLanes* lanes, JointLaneRow* rows, int begin, int end, double* bodies, int which,
+                           const ContactSweepParams& p);
 };
 
 enum class SimdLevel { Portable, Avx2, Avx512 };

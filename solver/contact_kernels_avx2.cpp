@@ -5,5 +5,5 @@
 
 namespace cairn {
 extern const ContactKernels kContactKernelsAvx2;
-const ContactKernels kContactKernelsAvx2 = avx2_kernels::makeKernels("avx2");
+constinit const ContactKernels kContactKernelsAvx2 = avx2_kernels::makeKernels("avx2");
 }  // namespace cairn

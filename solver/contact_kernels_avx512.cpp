@@ -6,5 +6,5 @@
 
 namespace cairn {
 extern const ContactKernels kContactKernelsAvx512;
-const ContactKernels kContactKernelsAvx512 = avx512_kernels::makeKernels("avx512");
+constinit const ContactKernels kContactKernelsAvx512 = avx512_kernels::makeKernels("avx512");
 }  // namespace cairn

@@ -5,5 +5,5 @@
 
 namespace cairn {
 extern const ContactKernels kContactKernelsPortable;
-const ContactKernels kContactKernelsPortable = portable_kernels::makeKernels("portable");
+constinit const ContactKernels kContactKernelsPortable = portable_kernels::makeKernels("portable");
 }  // namespace cairn

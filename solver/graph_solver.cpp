@@ -78,6 +78,130 @@ void solveGroup(GraphProblem& p, std::int32_t gi, std::span<SolverBody> bodies, 
   p.group_lambda[static_cast<size_t>(gi)] = max_lambda;
 }
 
+// --- Joints side by side (joint_lanes.hpp).
+
+// Joints with more rows than this stay alone (a 6-dof joint with every
+// limit and motor has twelve).
+constexpr int kMaxLaneRows = 16;
+
+// Whether a group can take a lane: no friction row (its bounds follow its
+// normal row's impulse), and every row between the same two bodies.
+bool fitsLane(const GraphProblem& p, const RowGroup& g) {
+  const int n = g.end - g.begin;
+  if (n <= 0 || n > kMaxLaneRows) return false;
+  const ConstraintRow& first = p.rows[static_cast<size_t>(g.begin)];
+  for (std::int32_t k = g.begin; k < g.end; ++k) {
+    const ConstraintRow& r = p.rows[static_cast<size_t>(k)];
+    if (r.normal_row >= 0 || r.body_a != first.body_a || r.body_b != first.body_b) return false;
+  }
+  return true;
+}
+
+void put3(double (*dst)[kBatchLanes], int l, const Vec3& v) {
+  for (int i = 0; i < 3; ++i) dst[i][l] = v[i];
+}
+
+// Lane l of `lane` takes group gi's rows.
+void fillLane(GraphProblem& p, JointLanes& lane, int l, std::int32_t gi) {
+  const RowGroup& g = p.groups[static_cast<size_t>(gi)];
+  const ConstraintRow* rows = p.rows.data() + g.begin;
+  lane.group[l] = gi;
+  lane.body_a[l] = rows[0].body_a;
+  lane.body_b[l] = rows[0].body_b;
+  lane.island[l] = g.island;
+  for (int k = 0; k < lane.rows; ++k) {
+    const ConstraintRow& r = rows[k];
+    JointLaneRow& q = p.joint_lane_rows[static_cast<size_t>(lane.row_begin + k)];
+    put3(q.j_lin_a, l, r.j_lin_a);
+    put3(q.j_ang_a, l, r.j_ang_a);
+    put3(q.j_lin_b, l, r.j_lin_b);
+    put3(q.j_ang_b, l, r.j_ang_b);
+    put3(q.m_lin_a, l, r.m_lin_a);
+    put3(q.m_ang_a, l, r.m_ang_a);
+    put3(q.m_lin_b, l, r.m_lin_b);
+    put3(q.m_ang_b, l, r.m_ang_b);
+    q.inv_diag[l] = r.inv_diag;
+    q.rhs[l] = r.rhs;
+    q.cfm[l] = r.cfm;
+    q.lo[l] = r.lo;
+    q.hi[l] = r.hi;
+    q.lambda[l] = r.lambda;
+    q.bias_rhs[l] = r.bias_rhs;
+    q.correction[l] = static_cast<double>(r.correction);
+  }
+}
+
+// Puts the joints of each colour that fit a lane into JointLanes of equal
+// row counts, in group order; a row count that gathers one joint leaves it
+// alone (a lane of one is the scalar visit with more work).
+void planJointLanes(GraphProblem& p) {
+  p.joint_lanes.clear();
+  p.joint_lane_rows.clear();
+  p.group_lanes.assign(p.groups.size(), kGroupAlone);
+  std::int32_t waiting[kMaxLaneRows + 1][kBatchLanes];
+  int count[kMaxLaneRows + 1] = {};
+  const auto emit = [&](int n) {
+    if (count[n] >= 2) {
+      const auto at = static_cast<std::int32_t>(p.joint_lanes.size());
+      JointLanes& lane = p.joint_lanes.emplace_back();
+      std::fill(std::begin(lane.group), std::end(lane.group), -1);
+      std::fill(std::begin(lane.body_a), std::end(lane.body_a), 0);  // an unused lane reads the world
+      std::fill(std::begin(lane.body_b), std::end(lane.body_b), 0);
+      std::fill(std::begin(lane.island), std::end(lane.island), 0);
+      lane.row_begin = static_cast<std::int32_t>(p.joint_lane_rows.size());
+      lane.rows = n;
+      p.joint_lane_rows.resize(p.joint_lane_rows.size() + static_cast<size_t>(n));  // zeros
+      for (int l = 0; l < count[n]; ++l) {
+        fillLane(p, lane, l, waiting[n][l]);
+        p.group_lanes[static_cast<size_t>(waiting[n][l])] = at * kBatchLanes + l;
+      }
+    }
+    count[n] = 0;
+  };
+  for (const GraphColour& c : p.colours) {
+    for (std::int32_t gi = c.group_begin; gi < c.group_end; ++gi) {
+      const RowGroup& g = p.groups[static_cast<size_t>(gi)];
+      if (!fitsLane(p, g)) continue;
+      const int n = g.end - g.begin;
+      waiting[n][count[n]++] = gi;
+      if (count[n] == kBatchLanes) emit(n);
+    }
+    for (int n = 1; n <= kMaxLaneRows; ++n) emit(n);
+  }
+}
+
+// The lanes' impulses back to their rows, when the sweeps end.
+void storeJointLanes(GraphProblem& p) {
+  for (const JointLanes& lane : p.joint_lanes)
+    for (int l = 0; l < kBatchLanes; ++l) {
+      if (lane.group[l] < 0) continue;
+      ConstraintRow* rows = p.rows.data() + p.groups[static_cast<size_t>(lane.group[l])].begin;
+      for (int k = 0; k < lane.rows; ++k)
+        rows[k].lambda = p.joint_lane_rows[static_cast<size_t>(lane.row_begin + k)].lambda[l];
+    }
+}
+
+// Group gi's change in the last sweep, row k: in its lane or its row.
+Real rowChange(const GraphProblem& p, std::int32_t gi, std::int32_t k) {
+  const std::int32_t at = p.joint_lanes.empty() ? kGroupAlone : p.group_lanes[static_cast<size_t>(gi)];
+  if (at == kGroupAlone) return p.row_change[static_cast<size_t>(p.groups[static_cast<size_t>(gi)].begin + k)];
+  const JointLanes& lane = p.joint_lanes[static_cast<size_t>(at / kBatchLanes)];
+  return p.joint_lane_rows[static_cast<size_t>(lane.row_begin + k)].change[at % kBatchLanes];
+}
+
+// The joints' largest change and impulse of lanes li's last visit, as
+// solveGroup and biasGroup record them (nothing for a joint whose island
+// has stopped).
+void recordLanes(GraphProblem& p, std::int32_t li) {
+  const JointLanes& lane = p.joint_lanes[static_cast<size_t>(li)];
+  for (int l = 0; l < kBatchLanes; ++l) {
+    const std::int32_t gi = lane.group[l];
+    if (gi < 0 || !active(p, lane.island[l])) continue;
+    p.group_delta[static_cast<size_t>(gi)] = lane.delta[l];
+    p.group_lambda[static_cast<size_t>(gi)] = lane.lambda[l];
+  }
+}
+
 void groupMomentum(GraphProblem& p, const RowGroup& g, std::span<SolverBody> bodies, int dynamic_end) {
   const double beta = p.island_beta[static_cast<size_t>(g.island)];
   if (beta < 0) return;  // the island has stopped
@@ -334,8 +458,8 @@ void islandBetas(GraphProblem& p, const Part& part) {
   }
   for (std::int32_t gi = part.group_begin; gi < part.group_end; ++gi) {
     const RowGroup& g = p.groups[static_cast<size_t>(gi)];
-    for (std::int32_t i = g.begin; i < g.end; ++i) {
-      const Real d = p.row_change[static_cast<size_t>(i)];
+    for (std::int32_t k = 0; k < g.end - g.begin; ++k) {
+      const Real d = rowChange(p, gi, k);
       p.island_norm2[static_cast<size_t>(g.island)] += d * d;
     }
   }
@@ -426,7 +550,15 @@ bool biasSweep(GraphProblem& p, const Part& part, bool flow, std::span<SolverBod
   forColours(
       p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end),
       [&](std::int32_t gi) {
-        if (groups) biasGroup(p, gi, bodies, which, o);
+        if (!groups) return;
+        const std::int32_t at = p.joint_lanes.empty() ? kGroupAlone : p.group_lanes[static_cast<size_t>(gi)];
+        if (at == kGroupAlone) {
+          biasGroup(p, gi, bodies, which, o);
+        } else if (at % kBatchLanes == 0) {  // a joint in another's lanes is visited with them
+          o.kernels->joint_lanes_bias(p.joint_lanes.data(), p.joint_lane_rows.data(), at / kBatchLanes,
+                                      at / kBatchLanes + 1, body_data, static_cast<int>(which), sp);
+          recordLanes(p, at / kBatchLanes);
+        }
       },
       [&](int b0, int b1) {
         if (contacts) o.kernels->solve_bias(p.batches.data(), b0, b1, body_data, sp);
@@ -478,6 +610,7 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
 
   const auto groupFn = [&](Pass pass) {
     return [&, pass](std::int32_t gi) {
+      const std::int32_t at = p.joint_lanes.empty() ? kGroupAlone : p.group_lanes[static_cast<size_t>(gi)];
       switch (pass) {
         case Pass::WarmStart: {  // the carried impulses act before the first sweep
           const RowGroup& g = p.groups[static_cast<size_t>(gi)];
@@ -487,9 +620,21 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
           }
           break;
         }
-        case Pass::Normals: solveGroup(p, gi, bodies, o, o.nncg); break;
+        case Pass::Normals:
+          if (at == kGroupAlone) solveGroup(p, gi, bodies, o, o.nncg);
+          else if (at % kBatchLanes == 0) {
+            o.kernels->solve_joint_lanes(p.joint_lanes.data(), p.joint_lane_rows.data(), at / kBatchLanes,
+                                         at / kBatchLanes + 1, body_data, sp);
+            recordLanes(p, at / kBatchLanes);
+          }
+          break;  // a joint in another's lanes is visited with them
         case Pass::Friction: break;  // a group's friction rows go with its normal rows
-        case Pass::Momentum: groupMomentum(p, p.groups[static_cast<size_t>(gi)], bodies, o.dynamic_end); break;
+        case Pass::Momentum:
+          if (at == kGroupAlone) groupMomentum(p, p.groups[static_cast<size_t>(gi)], bodies, o.dynamic_end);
+          else if (at % kBatchLanes == 0)
+            o.kernels->joint_lanes_momentum(p.joint_lanes.data(), p.joint_lane_rows.data(), at / kBatchLanes,
+                                            at / kBatchLanes + 1, body_data, p.island_beta.data(), sp);
+          break;
       }
     };
   };
@@ -575,6 +720,17 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
   p.correction_swept = false;
   if (p.empty()) return stats;
   startSweeps(p);
+  // Joints in lanes where the colours are swept one after another: the
+  // flow schedule and the pipeline start an item once the items it
+  // depends on are done, and a joint visited with its lanes' first one
+  // would look done before it is. (Both are planned here as sweepPart
+  // would plan them.)
+  p.joint_lanes.clear();
+  if (o.joint_lanes && o.kernels && p.groups.size() >= 2) {
+    const bool one_part = partCount(p, o) == 1;
+    const bool flow = one_part && useFlow(p, o);
+    if (!flow && !(one_part && usePipeline(p, o, flow))) planJointLanes(p);
+  }
   // The contacts' split-impulse correction with the velocity sweeps, where
   // it is the whole pseudo-velocity pass (no row group has a pseudo row)
   // and its colour order is the velocities' (not shuffled).
@@ -602,6 +758,7 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
     p.part_stats[static_cast<size_t>(k)] =
         sweepPart(p, part, p.part_order[static_cast<size_t>(k)], bodies, pseudo, po, rng_state);
   });
+  storeJointLanes(p);
   // The sweeps ended with the part that swept longest: its islands'
   // largest change is the last sweep's (as one part would report it).
   for (const int n : p.island_iterations) stats.iterations = std::max(stats.iterations, n);
@@ -618,6 +775,7 @@ namespace {
 void biasPass(GraphProblem& p, std::span<SolverBody> bodies, Correction which, bool contacts,
               const GraphSolveOptions& o) {
   startSweeps(p);
+  for (JointLaneRow& r : p.joint_lane_rows) std::fill(std::begin(r.lambda_bias), std::end(r.lambda_bias), 0.0);
   const ContactSweepParams sp = sweepParams(p, o, false);
   forParts(p, o, [&](int, const Part& part, const GraphSolveOptions& po) {
     const bool flow = useFlow(p, po);

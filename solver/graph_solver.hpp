@@ -29,6 +29,7 @@
 #include "solver/contact_batch.hpp"
 #include "solver/contact_kernels.hpp"
 #include "solver/huge_page_allocator.hpp"
+#include "solver/joint_lanes.hpp"
 #include "solver/pass_pipeline.hpp"
 #include "solver/solver_body.hpp"
 
@@ -46,6 +47,8 @@ struct RowGroup {
   std::int32_t begin = 0, end = 0;
   std::int32_t island = 0;
 };
+
+inline constexpr std::int32_t kGroupAlone = -1;
 
 // A joint's row group costs about 1 / kGroupsPerBatchVisit of a batch visit:
 // the work the thresholds and the flow plan count (graph_solver.cpp,
@@ -81,6 +84,14 @@ struct GraphProblem {
   // never share a sweep's result (each stops on its own, with its own
   // momentum), so the parts change nothing but which thread does the work.
   std::vector<std::int32_t> part_colour, part_island;
+
+  // Joints of a colour solved side by side (joint_lanes.hpp), made by
+  // solveGraph from the rows: per group, its lane (JointLanes index times
+  // kBatchLanes plus the lane; lane 0 is the lowest group, which visits
+  // the others with it) or kGroupAlone.
+  std::vector<JointLanes> joint_lanes;
+  std::vector<JointLaneRow> joint_lane_rows;
+  std::vector<std::int32_t> group_lanes;
 
   // Scratch, sized by the solver.
   std::vector<Real> row_change, row_dir, row_bias_lambda;
@@ -138,6 +149,10 @@ struct GraphSolveOptions {
   // same batch (one read of the batch for both); false leaves it to
   // solveGraphCorrection's pass of its own. The same bits either way.
   bool sweep_correction = true;
+  // Joints of a colour with the same number of rows solved side by side in
+  // the kernels' lanes (joint_lanes.hpp) where the colours are swept one
+  // after another; false solves each alone. The same bits either way.
+  bool joint_lanes = true;
 };
 
 // Warm start and the velocity sweeps. Given `pseudo` (zeroed by the

@@ -556,4 +556,38 @@ SceneDesc restitutionDrop(Real restitution) {
   return s;
 }
 
+SceneDesc sideBySide(const SceneDesc& one, int copies, const Vec3& offset) {
+  if (!one.springs.empty()) throw InputError("sideBySide", "springs", "copies scenes of bodies and joints only");
+  SceneDesc s = one;
+  s.bodies.clear();
+  s.joints.clear();
+  s.validation_json.clear();  // its checks name the bodies of one copy
+  std::vector<std::int32_t> static_index(one.bodies.size(), -1);
+  for (int c = 0; c < copies; ++c) {
+    std::vector<std::int32_t> index(one.bodies.size());
+    for (size_t i = 0; i < one.bodies.size(); ++i) {
+      BodyDef b = one.bodies[i];
+      if (b.type == BodyType::Static && static_index[i] >= 0) {
+        index[i] = static_index[i];
+        continue;
+      }
+      index[i] = static_cast<std::int32_t>(s.bodies.size());
+      if (b.type == BodyType::Static) static_index[i] = index[i];
+      else b.position += offset * Real(c);
+      b.name += "_" + std::to_string(c);
+      s.bodies.push_back(b);
+    }
+    for (JointDef j : one.joints) {
+      if (!j.body_a.isWorld()) j.body_a = BodyId{index[static_cast<size_t>(j.body_a.index)]};
+      if (!j.body_b.isWorld()) j.body_b = BodyId{index[static_cast<size_t>(j.body_b.index)]};
+      j.anchor += offset * Real(c);
+      j.anchor_a += offset * Real(c);
+      j.anchor_b += offset * Real(c);
+      j.name += "_" + std::to_string(c);
+      s.joints.push_back(j);
+    }
+  }
+  return s;
+}
+
 }  // namespace cairn::scenarios

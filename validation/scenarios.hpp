@@ -43,6 +43,12 @@ SceneDesc doublingStack(int boxes);            // doubling-stack-N: cubes whose 
 SceneDesc byName(const std::string& key);
 std::vector<std::string> standardNames();
 
+// `copies` copies of a scene's bodies and joints side by side, copy c moved
+// by c times `offset` and its names suffixed "_c"; static bodies (the
+// ground) once, shared by every copy. No validation block (its checks name
+// one copy's bodies); a scene with springs is refused (InputError).
+SceneDesc sideBySide(const SceneDesc& one, int copies, const Vec3& offset);
+
 // A dynamic body of one shape (friction 0.5, the BodyDef default).
 BodyDef solid(const std::string& name, Real mass, const Vec3& position, ShapeDesc shape);
 

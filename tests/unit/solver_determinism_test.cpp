@@ -384,6 +384,88 @@ TEST(Determinism, CorrectionSweptWithTheVelocitiesGivesTheBitsOfItsOwnPass) {
   expectSweptCorrectionGivesTheBitsOfItsOwnPass(sunkenPyramid(60), &pool, Real(1e-2));
 }
 
+// Joints side by side (solver/joint_lanes.hpp): up to eight joints of a
+// colour with the same number of rows are solved at once, one per vector
+// lane, with the arithmetic of each joint's own visit, so the impulses and
+// velocities must be those of every joint solved alone, bit for bit: with
+// every instruction set's kernels, on one thread and on two (a colour's
+// joints split between the threads), with NNCG's momentum (its steps in
+// the lanes too) and without, with the position-correction passes after
+// the sweeps, and with a tolerance at which the islands
+// stop after different numbers of sweeps (lanes of a stopped island left
+// as they are). Scenes: 32 chains of 20 ball joints, each nudged sideways
+// at its own speed, 0.25 m/s more than the last (every colour 32 joints
+// of three rows; the islands converge at different rates), and 16 ragdolls on
+// the ground (hinges and cone-twists with their limits: colours of mixed
+// row counts, contacts beside them).
+SceneDesc nudgedChains() {
+  SceneDesc s = scenarios::sideBySide(scenarios::chain(20), 32, Vec3(0, 0, 0.5));
+  for (size_t i = 0; i < s.bodies.size(); ++i) s.bodies[i].linear_velocity = Vec3(0, 0, Real(0.25) * Real(i / 20));
+  s.solver.method = SolverMethod::PGS;
+  return s;
+}
+
+void expectLanesGiveTheBitsOfJointsAlone(const World& w, WorkerPool* pool, SimdLevel level, bool nncg,
+                                         Real tolerance) {
+  TwoSolves two(w, pool);
+  GraphSolveOptions& o = two.options;
+  o.kernels = &contactKernels(level);
+  o.nncg = nncg;
+  o.tolerance = tolerance;
+  GraphProblem &lanes = two.graph[0], &alone = two.graph[1];
+  std::vector<SolverBody> pseudo[2] = {std::vector<SolverBody>(two.velocities[0].size()),
+                                       std::vector<SolverBody>(two.velocities[0].size())};
+  std::uint64_t rng = 1;
+  solveGraph(lanes, two.velocities[0], o, rng, pseudo[0]);
+  const bool corrected = solveGraphCorrection(lanes, two.velocities[0], pseudo[0], o);
+  o.joint_lanes = false;
+  solveGraph(alone, two.velocities[1], o, rng, pseudo[1]);
+  const std::vector<int> sweeps = alone.island_iterations;
+  EXPECT_EQ(solveGraphCorrection(alone, two.velocities[1], pseudo[1], o), corrected);
+  ASSERT_FALSE(lanes.joint_lanes.empty());
+  ASSERT_TRUE(alone.joint_lanes.empty());
+  if (tolerance > 0) {
+    const auto [fewest, most] = std::minmax_element(sweeps.begin(), sweeps.end());
+    ASSERT_LT(*fewest, *most) << "every island swept as long: no lane of a stopped island";
+  }
+  // The joints' position error is corrected after the sweeps (its own
+  // passes, visited in the lanes too): there must be some.
+  ASSERT_TRUE(std::any_of(alone.rows.begin(), alone.rows.end(), [](const ConstraintRow& r) {
+    return r.correction != Correction::InRhs && r.bias_rhs != 0;
+  }));
+  for (size_t i = 0; i < two.velocities[1].size(); ++i) {
+    EXPECT_EQ(two.velocities[0][i].v, two.velocities[1][i].v) << "body " << i;
+    EXPECT_EQ(two.velocities[0][i].w, two.velocities[1][i].w) << "body " << i;
+    EXPECT_EQ(pseudo[0][i].v, pseudo[1][i].v) << "body " << i;
+    EXPECT_EQ(pseudo[0][i].w, pseudo[1][i].w) << "body " << i;
+  }
+  int differ = 0;
+  for (size_t r = 0; r < alone.rows.size(); ++r) differ += lanes.rows[r].lambda != alone.rows[r].lambda;
+  EXPECT_EQ(differ, 0) << simdLevelName(level) << (nncg ? " NNCG" : " PGS") << " tolerance " << tolerance;
+}
+
+TEST(Determinism, JointsInLanesGiveTheBitsOfEachJointAlone) {
+  WorkerPool pool(2);
+  SceneDesc ragdolls = scenarios::sideBySide(scenarios::ragdoll(), 16, Vec3(2.5, 0, 0));
+  ragdolls.solver.method = SolverMethod::PGS;
+  const SceneDesc chains = nudgedChains();
+  for (const auto& [s, steps] : {std::pair{chains, 30}, std::pair{ragdolls, 60}}) {
+    World w = buildWorld(s);
+    for (int k = 0; k < steps; ++k) w.step(s.dt);
+    ASSERT_FALSE(detail::internals(w).stepContext().graph.joint_lanes.empty()) << "the step made no lanes";
+    for (const SimdLevel level : {SimdLevel::Portable, SimdLevel::Avx2, SimdLevel::Avx512}) {
+      if (!simdLevelAvailable(level)) continue;
+      for (WorkerPool* p : {static_cast<WorkerPool*>(nullptr), &pool})
+        for (const bool nncg : {true, false}) expectLanesGiveTheBitsOfJointsAlone(w, p, level, nncg, 0);
+    }
+  }
+  World w = buildWorld(chains);
+  for (int k = 0; k < 30; ++k) w.step(chains.dt);
+  // 0.01 N s: the chains' islands stop after 1 to 10 sweeps.
+  for (WorkerPool* p : {static_cast<WorkerPool*>(nullptr), &pool})
+    expectLanesGiveTheBitsOfJointsAlone(w, p, bestSimdLevel(), true, Real(1e-2));
+}
+
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {
   const SceneDesc s = scenarios::pyramid(10);
   const auto portable = run(s, kSteps, 1, Simd::Portable);

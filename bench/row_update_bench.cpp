@@ -163,23 +163,33 @@ void BM_ContactSolve(benchmark::State& state) {
 }
 BENCHMARK(BM_ContactSolve)->ArgName("simd")->DenseRange(0, 2)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
+// Ten velocity sweeps without NNCG over a captured joint problem, cold
+// (every sweep works), per row update over `rows`; the joints of a colour
+// side by side in the kernels' lanes or each alone.
+void timeColdSweeps(benchmark::State& state, const Captured& problem, double rows, bool joint_lanes) {
+  GraphSolveOptions o;
+  o.iterations = 10;
+  o.nncg = false;
+  o.dynamic_end = problem.dynamic_end;
+  o.kernels = &contactKernels(bestSimdLevel());
+  o.joint_lanes = joint_lanes;
+  state.SetLabel(o.kernels->name);
+  GraphProblem g;
+  timeSolveGraph(state, g, problem.velocities, rows, o, [&](GraphProblem& p) {
+    p = problem.graph;
+    for (ConstraintRow& r : p.rows) r.lambda = 0;
+  });
+  state.counters["colours"] = static_cast<double>(g.colours.size());
+  state.counters["lanes"] = static_cast<double>(g.joint_lanes.size());
+}
+
 void BM_JointRowUpdate(benchmark::State& state) {
   static const Captured problem = capture(scenarios::byName("chain-100"), 30);
   if (problem.joint_rows == 0) {
     state.SkipWithError("chain-100 left no joint rows in the PGS graph");
     return;
   }
-  constexpr int kSweeps = 10;
-  GraphProblem g = problem.graph;
-  GraphSolveOptions o;
-  o.iterations = kSweeps;
-  o.nncg = false;
-  o.dynamic_end = problem.dynamic_end;
-  o.kernels = &contactKernels(bestSimdLevel());
-  timeSolveGraph(state, g, problem.velocities, problem.joint_rows, o, [](GraphProblem& p) {
-    for (ConstraintRow& r : p.rows) r.lambda = 0;  // cold: every sweep works
-  });
-  state.counters["colours"] = static_cast<double>(g.colours.size());
+  timeColdSweeps(state, problem, problem.joint_rows, true);
 }
 BENCHMARK(BM_JointRowUpdate)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
@@ -196,22 +206,8 @@ void BM_JointLanes(benchmark::State& state) {
   static const Captured chains = capture(scenarios::sideBySide(scenarios::chain(20), 32, Vec3(0, 0, 0.5)), 30);
   static const Captured ragdolls = capture(scenarios::sideBySide(scenarios::byName("ragdoll"), 16, Vec3(2.5, 0, 0)), 60);
   const Captured& problem = state.range(0) == 0 ? chains : ragdolls;
-  constexpr int kSweeps = 10;
-  GraphProblem g = problem.graph;
-  GraphSolveOptions o;
-  o.iterations = kSweeps;
-  o.nncg = false;
-  o.dynamic_end = problem.dynamic_end;
-  o.kernels = &contactKernels(bestSimdLevel());
-  o.joint_lanes = state.range(1) != 0;
-  state.SetLabel(o.kernels->name);
-  timeSolveGraph(state, g, problem.velocities, problem.joint_rows + problem.contact_rows, o,
-                 [&](GraphProblem& p) {
-                   p = problem.graph;
-                   for (ConstraintRow& r : p.rows) r.lambda = 0;  // cold: every sweep works
-                 });
+  timeColdSweeps(state, problem, problem.joint_rows + problem.contact_rows, state.range(1) != 0);
   state.counters["joint_rows"] = problem.joint_rows;
-  state.counters["lanes"] = static_cast<double>(g.joint_lanes.size());
 }
 BENCHMARK(BM_JointLanes)
     ->ArgNames({"scene", "lanes"})

@@ -80,8 +80,9 @@ void solveGroup(GraphProblem& p, std::int32_t gi, std::span<SolverBody> bodies, 
 
 // --- Joints side by side (joint_lanes.hpp).
 
-// Joints with more rows than this stay alone (a 6-dof joint with every
-// limit and motor has twelve).
+// Joints with more rows than this stay alone (the plan's waiting lists
+// are sized by it; a joint has one to six rows, and one more for each
+// active limit or motor axis).
 constexpr int kMaxLaneRows = 16;
 
 // Whether a group can take a lane: no friction row (its bounds follow its

@@ -1,4 +1,4 @@
-// The joints' lane kernel (joint_lanes.hpp), written once for any vector
+// The joints' lane kernels (joint_lanes.hpp), written once for any vector
 // width W with the contact kernels' vector helpers: included by
 // contact_kernel_impl.hpp into each instruction set's unit, under the same
 // rules (no function shared with other units, no contraction).

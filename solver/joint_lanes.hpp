@@ -17,8 +17,9 @@
 // The lanes carry a copy of the rows, made when a solve starts, and keep
 // the impulses through its sweeps, with NNCG's changes and directions; the
 // impulses go back to the rows when the sweeps end. (Copied in and out
-// around each visit instead, the rows' impulses cost more than the lanes
-// saved: a row is 288 bytes, so each impulse is a cache line of its own.)
+// around each visit instead, the rows' impulses took most of what the
+// lanes saved: a row is 288 bytes, so each impulse is a cache line of its
+// own.)
 #pragma once
 
 #include "solver/contact_batch.hpp"

@@ -1,5 +1,5 @@
 // The contact solver's inner loops, written once for any vector width W
-// (1, 4 or 8 doubles) with GCC/Clang vector extensions. Included only by
+// (2, 4 or 8 doubles) with GCC/Clang vector extensions. Included only by
 // contact_kernels_portable.cpp, contact_kernels_avx2.cpp and
 // contact_kernels_avx512.cpp, each inside its own namespace
 // (CAIRN_KERNEL_NS) and compiled with its own target flags.
@@ -12,7 +12,7 @@
 //
 // Per lane the arithmetic is fixed and independent of W: masks freeze a
 // lane's iteration when it is done instead of letting its neighbours decide,
-// so W = 1, 4 and 8 give the same bits.
+// so W = 2, 4 and 8 give the same bits.
 //
 // Equations (contact_batch.hpp has the layout): a row along u at a point
 // with angular Jacobians -(r_a x u) and r_b x u has
@@ -43,9 +43,12 @@ namespace CAIRN_KERNEL_NS {
 namespace {
 
 template <int W> struct VecTypes;
-template <> struct VecTypes<1> {
-  typedef double D __attribute__((vector_size(8)));
-  typedef long long M __attribute__((vector_size(8)));
+// No VecTypes<1>: GCC 12 at -O2 folds a one-element mask wrongly once a
+// branch has tested it (after `if (!any(run)) continue;`, `run & (beta ==
+// 0)` came out zero for beta == 0), so the portable kernels use two lanes.
+template <> struct VecTypes<2> {
+  typedef double D __attribute__((vector_size(16)));
+  typedef long long M __attribute__((vector_size(16)));
 };
 template <> struct VecTypes<4> {
   typedef double D __attribute__((vector_size(32)));

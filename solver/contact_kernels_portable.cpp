@@ -1,6 +1,9 @@
-// The portable contact kernels: one lane at a time, any CPU.
+// The portable contact kernels, for any CPU: two lanes at a time, which is
+// SSE2 on x86-64, NEON on AArch64, and the compiler's own lowering
+// elsewhere. Not one lane: GCC 12 miscompiles masks of one-element vectors
+// (docs/decisions.md).
 #define CAIRN_KERNEL_NS portable_kernels
-#define CAIRN_KERNEL_LANES 1
+#define CAIRN_KERNEL_LANES 2
 #include "solver/contact_kernel_impl.hpp"
 
 namespace cairn {

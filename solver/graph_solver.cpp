@@ -103,13 +103,17 @@ void put3(double (*dst)[kBatchLanes], int l, const Vec3& v) {
 }
 
 // Lane l of `lane` takes group gi's rows.
-void fillLane(GraphProblem& p, JointLanes& lane, int l, std::int32_t gi) {
+void fillLane(GraphProblem& p, JointLanes& lane, int l, std::int32_t gi, int dynamic_end) {
   const RowGroup& g = p.groups[static_cast<size_t>(gi)];
   const ConstraintRow* rows = p.rows.data() + g.begin;
+  const auto writes = [&](std::int32_t body) { return body > 0 && body < dynamic_end ? 1.0 : 0.0; };  // as applyRow
   lane.group[l] = gi;
   lane.body_a[l] = rows[0].body_a;
   lane.body_b[l] = rows[0].body_b;
   lane.island[l] = g.island;
+  lane.used[l] = 1;
+  lane.writes_a[l] = writes(rows[0].body_a);
+  lane.writes_b[l] = writes(rows[0].body_b);
   for (int k = 0; k < lane.rows; ++k) {
     const ConstraintRow& r = rows[k];
     JointLaneRow& q = p.joint_lane_rows[static_cast<size_t>(lane.row_begin + k)];
@@ -135,7 +139,7 @@ void fillLane(GraphProblem& p, JointLanes& lane, int l, std::int32_t gi) {
 // Puts the joints of each colour that fit a lane into JointLanes of equal
 // row counts, in group order; a row count that gathers one joint leaves it
 // alone (a lane of one is the scalar visit with more work).
-void planJointLanes(GraphProblem& p) {
+void planJointLanes(GraphProblem& p, int dynamic_end) {
   p.joint_lanes.clear();
   p.joint_lane_rows.clear();
   p.group_lanes.assign(p.groups.size(), kGroupAlone);
@@ -149,11 +153,14 @@ void planJointLanes(GraphProblem& p) {
       std::fill(std::begin(lane.body_a), std::end(lane.body_a), 0);  // an unused lane reads the world
       std::fill(std::begin(lane.body_b), std::end(lane.body_b), 0);
       std::fill(std::begin(lane.island), std::end(lane.island), 0);
+      std::fill(std::begin(lane.used), std::end(lane.used), 0.0);
+      std::fill(std::begin(lane.writes_a), std::end(lane.writes_a), 0.0);
+      std::fill(std::begin(lane.writes_b), std::end(lane.writes_b), 0.0);
       lane.row_begin = static_cast<std::int32_t>(p.joint_lane_rows.size());
       lane.rows = n;
       p.joint_lane_rows.resize(p.joint_lane_rows.size() + static_cast<size_t>(n));  // zeros
       for (int l = 0; l < count[n]; ++l) {
-        fillLane(p, lane, l, waiting[n][l]);
+        fillLane(p, lane, l, waiting[n][l], dynamic_end);
         p.group_lanes[static_cast<size_t>(waiting[n][l])] = at * kBatchLanes + l;
       }
     }
@@ -182,9 +189,15 @@ void storeJointLanes(GraphProblem& p) {
     }
 }
 
+// Group gi's place in the lanes (JointLanes index * kBatchLanes + lane), or
+// kGroupAlone when it is solved alone or no lanes were planned this solve.
+std::int32_t laneOf(const GraphProblem& p, std::int32_t gi) {
+  return p.joint_lanes.empty() ? kGroupAlone : p.group_lanes[static_cast<size_t>(gi)];
+}
+
 // Group gi's change in the last sweep, row k: in its lane or its row.
 Real rowChange(const GraphProblem& p, std::int32_t gi, std::int32_t k) {
-  const std::int32_t at = p.joint_lanes.empty() ? kGroupAlone : p.group_lanes[static_cast<size_t>(gi)];
+  const std::int32_t at = laneOf(p, gi);
   if (at == kGroupAlone) return p.row_change[static_cast<size_t>(p.groups[static_cast<size_t>(gi)].begin + k)];
   const JointLanes& lane = p.joint_lanes[static_cast<size_t>(at / kBatchLanes)];
   return p.joint_lane_rows[static_cast<size_t>(lane.row_begin + k)].change[at % kBatchLanes];
@@ -552,7 +565,7 @@ bool biasSweep(GraphProblem& p, const Part& part, bool flow, std::span<SolverBod
       p, flow, o.pool, std::views::iota(part.colour_begin, part.colour_end),
       [&](std::int32_t gi) {
         if (!groups) return;
-        const std::int32_t at = p.joint_lanes.empty() ? kGroupAlone : p.group_lanes[static_cast<size_t>(gi)];
+        const std::int32_t at = laneOf(p, gi);
         if (at == kGroupAlone) {
           biasGroup(p, gi, bodies, which, o);
         } else if (at % kBatchLanes == 0) {  // a joint in another's lanes is visited with them
@@ -611,7 +624,7 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
 
   const auto groupFn = [&](Pass pass) {
     return [&, pass](std::int32_t gi) {
-      const std::int32_t at = p.joint_lanes.empty() ? kGroupAlone : p.group_lanes[static_cast<size_t>(gi)];
+      const std::int32_t at = laneOf(p, gi);
       switch (pass) {
         case Pass::WarmStart: {  // the carried impulses act before the first sweep
           const RowGroup& g = p.groups[static_cast<size_t>(gi)];
@@ -730,7 +743,7 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
   if (o.joint_lanes && o.kernels && p.groups.size() >= 2) {
     const bool one_part = partCount(p, o) == 1;
     const bool flow = one_part && useFlow(p, o);
-    if (!flow && !(one_part && usePipeline(p, o, flow))) planJointLanes(p);
+    if (!flow && !(one_part && usePipeline(p, o, flow))) planJointLanes(p, o.dynamic_end);
   }
   // The contacts' split-impulse correction with the velocity sweeps, where
   // it is the whole pseudo-velocity pass (no row group has a pseudo row)

@@ -25,20 +25,16 @@ struct JointKernel : Kernel<W> {
   CAIRN_INLINE V3 addIf(M write, const V3& v, const double (*m)[kBatchLanes], int o, D d) {
     return K::sel3(write, K::add(v, K::mul(K::ld3(m, o), d)), v);
   }
-  static inline M writable(const std::int32_t* body, int dynamic_end, M active) {
-    D w = K::zero();
-    for (int i = 0; i < W; ++i) w[i] = body[i] > 0 && body[i] < dynamic_end ? 1 : 0;
-    return active & (w > 0);
-  }
-
+  // The lanes in use whose island still sweeps (all in use, without
+  // island_active).
   static inline M usedLanes(const JointLanes& lane, int o, const double* island_active) {
-    D on = K::zero();
-    for (int i = 0; i < W; ++i) {
-      const bool used = lane.group[o + i] >= 0;
-      on[i] = used && (!island_active || island_active[lane.island[o + i]] > 0) ? 1 : 0;
-    }
+    D on = K::ld(lane.used + o);
+    if (island_active)
+      for (int i = 0; i < W; ++i) on[i] = on[i] > 0 && island_active[lane.island[o + i]] > 0 ? 1 : 0;
     return on > 0;
   }
+  // Which lanes of `active` write their body (the plan's flags).
+  static inline M writes(const double* flags, int o, M active) { return active & (K::ld(flags + o) > 0); }
 
   // One visit of lanes [o, o + W) of `lane` on the velocities `bodies`,
   // from the impulses `impulse` toward the targets `target`, of the rows
@@ -52,8 +48,8 @@ struct JointKernel : Kernel<W> {
     const M active = usedLanes(lane, o, p.island_active);
     if (!K::any(active)) return;
     const D sor = K::splat(p.sor);
-    const M write_a = writable(lane.body_a + o, p.dynamic_end, active);
-    const M write_b = writable(lane.body_b + o, p.dynamic_end, active);
+    const M write_a = writes(lane.writes_a, o, active);
+    const M write_b = writes(lane.writes_b, o, active);
     V3 va, wa, vb, wb;
     K::gather1(bodies, lane.body_a + o, va, wa);
     K::gather1(bodies, lane.body_b + o, vb, wb);
@@ -117,17 +113,16 @@ struct JointKernel : Kernel<W> {
     for (int li = begin; li < end; ++li) {
       JointLanes& lane = lanes[li];
       for (int o = 0; o < kBatchLanes; o += W) {
-        const M used = usedLanes(lane, o, nullptr);
-        D beta = K::splat(-1);
+        D beta = K::splat(-1);  // an unused lane is left as it is, as a stopped island's
         for (int i = 0; i < W; ++i)
           if (lane.group[o + i] >= 0) beta[i] = island_beta[lane.island[o + i]];
-        const M run = used & (beta >= 0);
+        const M run = beta >= 0;
         if (!K::any(run)) continue;
         const M restart = run & ((beta == 0) | (beta > 1));
         const M step = run & ~restart;
         const bool steps = K::any(step);
-        const M write_a = writable(lane.body_a + o, p.dynamic_end, step);
-        const M write_b = writable(lane.body_b + o, p.dynamic_end, step);
+        const M write_a = writes(lane.writes_a, o, step);
+        const M write_b = writes(lane.writes_b, o, step);
         V3 va, wa, vb, wb;
         if (steps) {
           K::gather1(bodies, lane.body_a + o, va, wa);

@@ -50,6 +50,11 @@ struct alignas(64) JointLanes {
   std::int32_t body_a[kBatchLanes];  // solver body indices, the same for all of a group's rows
   std::int32_t body_b[kBatchLanes];
   std::int32_t island[kBatchLanes];
+  // 1 where the lane is used and its body is a dynamic solver body (a row
+  // update writes its velocity), else 0: the same for the whole solve.
+  double used[kBatchLanes];
+  double writes_a[kBatchLanes];
+  double writes_b[kBatchLanes];
   std::int32_t row_begin = 0;  // the first of its `rows` JointLaneRows
   std::int32_t rows = 0;
   double delta[kBatchLanes];   // out: the visit's largest change per lane

@@ -1,5 +1,5 @@
 // The contact solver's inner loops (and the joints' lanes, joint_lanes.hpp),
-// one set per instruction set: portable (one lane at a time, any CPU), AVX2
+// one set per instruction set: portable (two doubles, any CPU), AVX2
 // (four doubles) and AVX-512 (eight).
 // Each set is compiled in its own translation unit with its own target
 // flags (solver/contact_kernels_*.cpp) from the one template in

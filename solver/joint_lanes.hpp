@@ -50,8 +50,10 @@ struct alignas(64) JointLanes {
   std::int32_t body_a[kBatchLanes];  // solver body indices, the same for all of a group's rows
   std::int32_t body_b[kBatchLanes];
   std::int32_t island[kBatchLanes];
-  // 1 where the lane is used and its body is a dynamic solver body (a row
-  // update writes its velocity), else 0: the same for the whole solve.
+  // Set by the plan, the same for the whole solve: `used` is 1 where the
+  // lane holds a joint; `writes_a` and `writes_b` are 1 where, besides, its
+  // body a or b is a dynamic solver body (a row update writes its
+  // velocity). 0 elsewhere.
   double used[kBatchLanes];
   double writes_a[kBatchLanes];
   double writes_b[kBatchLanes];

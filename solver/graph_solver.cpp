@@ -26,15 +26,19 @@ inline Real rowVelocity(const ConstraintRow& r, const SolverBody& a, const Solve
   return r.j_lin_a.dot(a.v) + r.j_ang_a.dot(a.w) + r.j_lin_b.dot(b.v) + r.j_ang_b.dot(b.w);
 }
 
+// Whether a row update writes solver body `body`: a dynamic one (the world
+// is 0; static and kinematic bodies come from dynamic_end on).
+inline bool writable(std::int32_t body, int dynamic_end) { return body > 0 && body < dynamic_end; }
+
 // Adds M^-1 J^T d to the row's bodies that may be written (pgs.cpp's
 // applyImpulse, without touching the read-only bodies).
 inline void applyRow(const ConstraintRow& r, std::span<SolverBody> bodies, int dynamic_end, Real d) {
-  if (r.body_a > 0 && r.body_a < dynamic_end) {
+  if (writable(r.body_a, dynamic_end)) {
     SolverBody& a = bodies[static_cast<size_t>(r.body_a)];
     a.v += r.m_lin_a * d;
     a.w += r.m_ang_a * d;
   }
-  if (r.body_b > 0 && r.body_b < dynamic_end) {
+  if (writable(r.body_b, dynamic_end)) {
     SolverBody& b = bodies[static_cast<size_t>(r.body_b)];
     b.v += r.m_lin_b * d;
     b.w += r.m_ang_b * d;
@@ -106,14 +110,13 @@ void put3(double (*dst)[kBatchLanes], int l, const Vec3& v) {
 void fillLane(GraphProblem& p, JointLanes& lane, int l, std::int32_t gi, int dynamic_end) {
   const RowGroup& g = p.groups[static_cast<size_t>(gi)];
   const ConstraintRow* rows = p.rows.data() + g.begin;
-  const auto writes = [&](std::int32_t body) { return body > 0 && body < dynamic_end ? 1.0 : 0.0; };  // as applyRow
   lane.group[l] = gi;
   lane.body_a[l] = rows[0].body_a;
   lane.body_b[l] = rows[0].body_b;
   lane.island[l] = g.island;
   lane.used[l] = 1;
-  lane.writes_a[l] = writes(rows[0].body_a);
-  lane.writes_b[l] = writes(rows[0].body_b);
+  lane.writes_a[l] = writable(rows[0].body_a, dynamic_end) ? 1 : 0;
+  lane.writes_b[l] = writable(rows[0].body_b, dynamic_end) ? 1 : 0;
   for (int k = 0; k < lane.rows; ++k) {
     const ConstraintRow& r = rows[k];
     JointLaneRow& q = p.joint_lane_rows[static_cast<size_t>(lane.row_begin + k)];

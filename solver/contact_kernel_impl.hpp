@@ -720,8 +720,75 @@ struct Kernel {
   }
   CAIRN_INLINE V3 sel3(M m, const V3& a, const V3& b) { return {sel(m, a.x, b.x), sel(m, a.y, b.y), sel(m, a.z, b.z)}; }
 
+  // A point's targets from its separation along the normal: close a gap
+  // within the (sub)step and no more (speculative); push the penetration
+  // beyond the slop out at contact_erp / h. Zeros where `ok` is clear.
+  CAIRN_INLINE void putTargets(ContactBatch::Point& q, int o, M ok, D sep, const ContactFillParams& p) {
+    const D zero_ = zero(), h = splat(p.h);
+    const D want = splat(p.contact_erp) / h * (-sep - splat(p.slop));
+    const D clamped = sel(want < 0, zero_, sel(splat(p.max_correction) < want, splat(p.max_correction), want));
+    const D push = sel(sep > 0, zero_, clamped);
+    D rhs = sel(sep > 0, -sep / h, zero_);
+    if (p.in_rhs) {
+      rhs = sel(rhs < push, push, rhs);  // std::max's choice, NaN included
+      st(q.bias + o, zero_);
+    } else {
+      // Every point of the manifold takes part in the correction pass
+      // (target 0 within the slop, -gap/h while separated), so pushing
+      // one corner out lifts the body instead of tipping it.
+      st(q.bias + o, sel(ok, sel(sep > 0, -sep / h, push), zero_));  // > 0: being pushed out
+    }
+    st(q.rhs + o, sel(ok, rhs, zero_));
+  }
+
+  // The sweeps' per-step figures of a lane group, from zero.
+  CAIRN_INLINE void clearSweepState(ContactBatch& b, int o) {
+    const D zero_ = zero();
+    st(b.sweep_delta + o, zero_);
+    st(b.sweep_lambda + o, zero_);
+    st(b.change2 + o, zero_);
+    for (ContactBatch::Point& q : b.p) {
+      st(q.lambda_bias + o, zero_);
+      st(q.change_n + o, zero_);
+      st(q.dir_n + o, zero_);
+      for (int k = 0; k < 2; ++k) {
+        st(q.change_t[k] + o, zero_);
+        st(q.dir_t[k] + o, zero_);
+      }
+    }
+  }
+
+  // A later substep of a batch filled at the step's first (SolverSettings::
+  // prepare_contacts_each_substep false): the Jacobians, effective masses,
+  // tangents and the normal block stay as the fill made them, and only what
+  // the bodies' motion since changes is made again: each point's
+  // separation, from its anchors fixed in the bodies at their present poses
+  // (in.a and in.b: x and q; in.p: the local anchors), and its targets; the
+  // carried impulses are warm-started again (times the factor, as the fill
+  // takes them from the contact), and the sweeps' figures start from zero.
+  // Box2D v3's b2SolveContact likewise keeps each point's anchors and masses
+  // over the substeps and measures the separation anew.
+  static void refresh(ContactBatch& b, const ContactBatchInput& in, const ContactFillParams& p) {
+    const D zero_ = zero(), warm = splat(p.warm);
+    for (int o = 0; o < kBatchLanes; o += W) {
+      clearSweepState(b, o);
+      const V3 n = ld3(b.n, o);
+      const V3 xa = ld3(in.a.x, o), xb = ld3(in.b.x, o);
+      for (int i = 0; i < kMaxPoints; ++i) {
+        ContactBatch::Point& q = b.p[i];
+        const ContactBatchInput::Point& ip = in.p[i];
+        const M ok = ld(q.valid + o) > 0;
+        const V3 pa = add(xa, rotate(in.a, o, ld3(ip.local_a, o)));
+        const V3 pb = add(xb, rotate(in.b, o, ld3(ip.local_b, o)));
+        putTargets(q, o, ok, dot(sub(pb, pa), n), p);
+        st(q.lambda + o, sel(ok, warm * ld(q.lambda + o), zero_));
+        for (int k = 0; k < 2; ++k) st(q.lambda_t[k] + o, warm * ld(q.lambda_t[k] + o));
+      }
+    }
+  }
+
   static void fill(ContactBatch& b, const ContactBatchInput& in, const ContactFillParams& p) {
-    const D zero_ = zero(), one = splat(1), cfm = splat(p.cfm), h = splat(p.h);
+    const D zero_ = zero(), one = splat(1), cfm = splat(p.cfm);
     for (int o = 0; o < kBatchLanes; o += W) {
       D count;
       for (int i = 0; i < W; ++i) count[i] = b.count[o + i];
@@ -739,9 +806,7 @@ struct Kernel {
       const D mu = ld(in.friction + o);
       st(b.mu + o, mu);
       st(b.cfm + o, sel(count > 0, cfm, zero_));  // a padding lane has no rows, and no CFM
-      st(b.sweep_delta + o, zero_);
-      st(b.sweep_lambda + o, zero_);
-      st(b.change2 + o, zero_);
+      clearSweepState(b, o);
       const V3 m_ab = add(ma, mb);
       const V3 xa = ld3(in.a.x, o), xb = ld3(in.b.x, o);
       const V3 va = ld3(in.a.v, o), wa = ld3(in.a.w, o), vb = ld3(in.b.v, o), wb = ld3(in.b.w, o);
@@ -773,31 +838,8 @@ struct Kernel {
         put3(q.ran, ran[i]);
         put3(q.rbn, rbn[i]);
         put(q.normal_mass, k + cfm);  // inverted with the batch
-        st(q.lambda_bias + o, zero_);
-        st(q.change_n + o, zero_);
-        st(q.dir_n + o, zero_);
-        for (int k2 = 0; k2 < 2; ++k2) {
-          st(q.change_t[k2] + o, zero_);
-          st(q.dir_t[k2] + o, zero_);
-        }
 
-        // Targets: close a gap within the step and no more (speculative);
-        // push the penetration beyond the slop out at contact_erp / h.
-        const D sep = dot(sub(pb, pa), n);
-        const D want = splat(p.contact_erp) / h * (-sep - splat(p.slop));
-        const D clamped = sel(want < 0, zero_, sel(splat(p.max_correction) < want, splat(p.max_correction), want));
-        const D push = sel(sep > 0, zero_, clamped);
-        D rhs = sel(sep > 0, -sep / h, zero_);
-        if (p.in_rhs) {
-          rhs = sel(rhs < push, push, rhs);  // std::max's choice, NaN included
-          st(q.bias + o, zero_);
-        } else {
-          // Every point of the manifold takes part in the correction pass
-          // (target 0 within the slop, -gap/h while separated), so pushing
-          // one corner out lifts the body instead of tipping it.
-          put(q.bias, sel(sep > 0, -sep / h, push));  // > 0: being pushed out
-        }
-        put(q.rhs, rhs);
+        putTargets(q, o, ok, dot(sub(pb, pa), n), p);
         // Restitution: the approach speed at detection, before this step's
         // forces, applied once after the solve (the restitution kernel).
         const D approach = ld(ip.approach_speed + o), e = ld(in.restitution + o);
@@ -872,7 +914,7 @@ constexpr ContactKernels makeKernels(const char* name) {
   using K = Kernel<CAIRN_KERNEL_LANES>;
   return ContactKernels{name,         CAIRN_KERNEL_LANES, &K::warmStart,   &K::solveNormals,
                         &K::solveFriction, &K::momentum, &K::solveBias, &K::restitution,
-                        &K::fill,     &JointKernel<CAIRN_KERNEL_LANES>::solveLanes,
+                        &K::fill,     &K::refresh, &JointKernel<CAIRN_KERNEL_LANES>::solveLanes,
                         &JointKernel<CAIRN_KERNEL_LANES>::momentumLanes,
                         &JointKernel<CAIRN_KERNEL_LANES>::biasLanes};
 }

@@ -55,6 +55,12 @@ struct ContactKernels {
   // body_b, island and count are already set; the Cholesky factor and the
   // inverted effective masses are the step's, after this).
   void (*fill)(ContactBatch& batch, const ContactBatchInput& in, const ContactFillParams& p);
+  // A later substep of a batch `fill` made at the step's first: each
+  // point's separation and targets at the bodies' present poses (in: x, q
+  // and the points' local anchors), the carried impulses warm-started again
+  // (ContactFillParams::warm), the sweeps' figures cleared; masses,
+  // Jacobians and the factor kept.
+  void (*refresh)(ContactBatch& batch, const ContactBatchInput& in, const ContactFillParams& p);
   // One projected Gauss-Seidel visit of the joints in the lanes of
   // lanes[begin, end) (joint_lanes.hpp), each joint's rows in order, with
   // the bits of each joint's scalar visit; and NNCG's momentum step on

@@ -30,7 +30,7 @@ constexpr Key kKeys[] = {
     {"split_impulse", Type::Bool}, {"slop", Type::Real},        {"nncg", Type::Bool},
     {"sleeping", Type::Bool},     {"geometric_stiffness", Type::Bool}, {"position_iterations", Type::Int},
     {"recycle_distance", Type::Real}, {"recycle_angle", Type::Real}, {"friction_directions", Type::Int},
-    {"position_correction", Type::Correction},
+    {"position_correction", Type::Correction}, {"prepare_contacts_each_substep", Type::Bool},
 };
 
 const Key* findKey(const std::string& name) {
@@ -130,6 +130,7 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
       else if (key == "nncg") s.nncg = v;
       else if (key == "sleeping") s.sleeping = v;
       else if (key == "geometric_stiffness") s.geometric_stiffness = v;
+      else if (key == "prepare_contacts_each_substep") s.prepare_contacts_each_substep = v;
       else s.split_impulse = v;
       break;
     }
@@ -180,6 +181,7 @@ std::string solverKeyValue(const SceneDesc& scene, const std::string& key) {
   if (key == "nncg") return s.nncg ? "true" : "false";
   if (key == "sleeping") return s.sleeping ? "true" : "false";
   if (key == "geometric_stiffness") return s.geometric_stiffness ? "true" : "false";
+  if (key == "prepare_contacts_each_substep") return s.prepare_contacts_each_substep ? "true" : "false";
   if (key == "position_iterations") return std::to_string(s.position_iterations);
   if (key == "recycle_distance") return exactNumberText(s.recycle_distance);
   if (key == "recycle_angle") return exactNumberText(s.recycle_angle);

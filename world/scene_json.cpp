@@ -497,6 +497,7 @@ SolverSettings parseSolver(const json& j) {
   s.nncg = r.boolean("nncg", s.nncg);
   s.seed = r.u64("seed", s.seed);
   s.substeps = r.intIn("substeps", s.substeps, 1);
+  s.prepare_contacts_each_substep = r.boolean("prepare_contacts_each_substep", s.prepare_contacts_each_substep);
   s.erp = r.number("erp", s.erp);
   s.cfm = r.number("cfm", s.cfm);
   s.contact_erp = r.number("contact_erp", s.contact_erp);

@@ -35,7 +35,7 @@ namespace {
 
 // A new field changes these sizes (x86-64, libstdc++): the compiler then
 // points here, to add it below and bump kSnapshotVersion.
-static_assert(sizeof(SolverSettings) == 264, "SolverSettings changed: update snapshot_state.cpp");
+static_assert(sizeof(SolverSettings) == 272, "SolverSettings changed: update snapshot_state.cpp");
 static_assert(sizeof(Body) == 960, "Body changed: update snapshot_state.cpp");
 static_assert(sizeof(ShapeDesc) == 208, "ShapeDesc changed: update snapshot_state.cpp");
 static_assert(sizeof(Joint) == 3456, "Joint changed: update snapshot_state.cpp");
@@ -89,6 +89,7 @@ void io(Ar& ar, SolverSettings& s) {
   ar(s.nncg);
   ar(s.seed);
   ar(s.substeps);
+  ar(s.prepare_contacts_each_substep);
   ar(s.threads);
   io(ar, s.simd, 4);
   ar(s.compute_residual);

@@ -466,6 +466,21 @@ TEST(Determinism, JointsInLanesGiveTheBitsOfEachJointAlone) {
     expectLanesGiveTheBitsOfJointsAlone(w, p, bestSimdLevel(), true, Real(1e-2));
 }
 
+// Contacts prepared once per step and refreshed at later substeps
+// (SolverSettings::prepare_contacts_each_substep false): pyramid-20's 111
+// batches are refreshed on the pool's threads, and by each kernel level's
+// refresh, with one set of bits.
+TEST(Determinism, RefreshedContactsAreBitIdenticalOnAnyThreadsAndKernels) {
+  SceneDesc s = scenarios::pyramid(20);
+  s.solver.substeps = 4;
+  s.solver.iterations = 3;
+  s.solver.prepare_contacts_each_substep = false;
+  const auto one = run(s, 20, 1, Simd::Portable);
+  expectIdentical(one, run(s, 20, 2, Simd::Portable));
+  if (simdLevelAvailable(SimdLevel::Avx2)) expectIdentical(one, run(s, 20, 2, Simd::Avx2));
+  if (simdLevelAvailable(SimdLevel::Avx512)) expectIdentical(one, run(s, 20, 1, Simd::Avx512));
+}
+
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {
   const SceneDesc s = scenarios::pyramid(10);
   const auto portable = run(s, kSteps, 1, Simd::Portable);

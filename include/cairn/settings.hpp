@@ -76,10 +76,11 @@ struct SolverSettings {
   /// block); false, each manifold is prepared once per step and later
   /// substeps only refresh each point's separation and targets from the
   /// bodies' new poses, as Box2D v3's solver.c does: cheaper, but a body
-  /// that turns within the step is pushed along anchors a substep old, and
-  /// a spinning box bouncing at restitution 1 gains energy (docs/
-  /// performance.md measures both). Either way the graph's layout (order,
-  /// colours, lanes) is made once per step.
+  /// that turns within the step is pushed along anchors a substep old (a
+  /// batch with a bouncing point is prepared anew on the last substep, so
+  /// that restitution adds no energy; docs/performance.md measures both).
+  /// Either way the graph's layout (order, colours, lanes) is made once
+  /// per step.
   bool prepare_contacts_each_substep = true;
   int threads = 1;              ///< worker threads for the step (results are bit-identical for any count); while they lose their cores to other work the step runs on one (StepStats::threads)
   Simd simd = Simd::Auto;       ///< contact solver instruction set

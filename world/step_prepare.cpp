@@ -96,48 +96,14 @@ void invertRowMasses(ContactBatch& b) {
   }
 }
 
-// One manifold and its bodies into one lane of the fill kernel's input
-// (solver/contact_batch.hpp lists the fields; the kernel makes the lane).
-void gatherLane(ContactBatchInput& in, ContactBatch& batch, int lane, const Contact& c, const BodyView& a,
-                const BodyView& b, std::int32_t island) {
-  batch.body_a[lane] = a.solver_index;
-  batch.body_b[lane] = b.solver_index;
-  batch.island[lane] = island;
-  batch.count[lane] = c.count;
-  const auto side = [lane](ContactBatchInput::Side& s, const BodyView& v) {
-    for (int k = 0; k < 3; ++k) {
-      s.x[k][lane] = v.x[k];
-      s.lin_factor[k][lane] = v.lin_factor[k];
-      s.v[k][lane] = v.v[k];
-      s.w[k][lane] = v.w[k];
-      for (int j = 0; j < 3; ++j) s.inv_inertia[3 * k + j][lane] = v.inv_inertia(k, j);
-    }
-    for (int k = 0; k < 4; ++k) s.q[k][lane] = v.q.coeffs()[k];  // x, y, z, w
-    s.inv_mass[lane] = v.inv_mass;
-  };
-  side(in.a, a);
-  side(in.b, b);
-  for (int k = 0; k < 3; ++k) in.n[k][lane] = c.normal[k];
-  in.friction[lane] = c.friction;
-  in.restitution[lane] = c.restitution;
-  for (int i = 0; i < kMaxPoints; ++i) {
-    ContactBatchInput::Point& q = in.p[i];
-    static const ContactPointState kNoPoint;  // a point past the count reads as zeros
-    const ContactPointState& s = i < c.count ? c.points[i] : kNoPoint;
-    for (int k = 0; k < 3; ++k) {
-      q.local_a[k][lane] = s.local_a[k];
-      q.local_b[k][lane] = s.local_b[k];
-      q.friction_impulse[k][lane] = s.friction_impulse[k];
-    }
-    q.approach_speed[lane] = s.approach_speed;
-    q.max_impulse[lane] = s.max_impulse;
-    q.normal_impulse[lane] = s.normal_impulse;
-  }
-}
+// A point past a manifold's count reads as zeros; a padding lane (the rest
+// of a colour's last batch) is the world on both sides, with no points.
+const ContactPointState kNoPoint;
+const Contact kPadding;
 
-// What the refresh kernel reads for one lane at a later substep: the two
-// bodies' present poses and the points' anchors fixed in them (the rest of
-// the lane is the fill's, kept from the step's first substep).
+// What the refresh kernel reads for one lane at a later substep, and the
+// fill kernel with the rest: the two bodies' present poses and the points'
+// anchors fixed in them.
 void gatherPoses(ContactBatchInput& in, int lane, const Contact& c, const WorldImpl& w) {
   const auto side = [&](ContactBatchInput::Side& s, BodyId id) {
     static const Body kWorld;  // the world: at the origin, unrotated
@@ -148,12 +114,45 @@ void gatherPoses(ContactBatchInput& in, int lane, const Contact& c, const WorldI
   side(in.a, c.body_a);
   side(in.b, c.body_b);
   for (int i = 0; i < kMaxPoints; ++i) {
-    static const ContactPointState kNoPoint;  // a point past the count reads as zeros
     const ContactPointState& p = i < c.count ? c.points[i] : kNoPoint;
     for (int k = 0; k < 3; ++k) {
       in.p[i].local_a[k][lane] = p.local_a[k];
       in.p[i].local_b[k][lane] = p.local_b[k];
     }
+  }
+}
+
+// One manifold and its bodies into one lane of the fill kernel's input
+// (solver/contact_batch.hpp lists the fields; the kernel makes the lane):
+// the poses and anchors as the refresh reads them, then the rest.
+void gatherLane(ContactBatchInput& in, ContactBatch& batch, int lane, const Contact& c, const BodyView& a,
+                const BodyView& b, std::int32_t island, const WorldImpl& w) {
+  gatherPoses(in, lane, c, w);
+  batch.body_a[lane] = a.solver_index;
+  batch.body_b[lane] = b.solver_index;
+  batch.island[lane] = island;
+  batch.count[lane] = c.count;
+  const auto side = [lane](ContactBatchInput::Side& s, const BodyView& v) {
+    for (int k = 0; k < 3; ++k) {
+      s.lin_factor[k][lane] = v.lin_factor[k];
+      s.v[k][lane] = v.v[k];
+      s.w[k][lane] = v.w[k];
+      for (int j = 0; j < 3; ++j) s.inv_inertia[3 * k + j][lane] = v.inv_inertia(k, j);
+    }
+    s.inv_mass[lane] = v.inv_mass;
+  };
+  side(in.a, a);
+  side(in.b, b);
+  for (int k = 0; k < 3; ++k) in.n[k][lane] = c.normal[k];
+  in.friction[lane] = c.friction;
+  in.restitution[lane] = c.restitution;
+  for (int i = 0; i < kMaxPoints; ++i) {
+    ContactBatchInput::Point& q = in.p[i];
+    const ContactPointState& s = i < c.count ? c.points[i] : kNoPoint;
+    for (int k = 0; k < 3; ++k) q.friction_impulse[k][lane] = s.friction_impulse[k];
+    q.approach_speed[lane] = s.approach_speed;
+    q.max_impulse[lane] = s.max_impulse;
+    q.normal_impulse[lane] = s.normal_impulse;
   }
 }
 
@@ -215,8 +214,6 @@ void layoutGraph(WorldImpl& w, StepContext& ctx) {
   g.island_count = ctx.island_count;
   ctx.lane_contact.clear();
   ctx.group_joint.clear();
-  const auto live = [&](std::int32_t isl) { return liveIsland(ctx, isl); };
-  const auto pgs = [&](std::int32_t isl) { return pgsIsland(ctx, isl); };
 
   // 1. The island of every joint and contact.
   ctx.joint_island.assign(w.joints_.size(), -1);
@@ -239,14 +236,14 @@ void layoutGraph(WorldImpl& w, StepContext& ctx) {
   items.clear();
   for (size_t i = 0; i < w.joints_.size(); ++i) {
     const std::int32_t isl = ctx.joint_island[i];
-    if (!live(isl) || !pgs(isl)) continue;
+    if (!liveIsland(ctx, isl) || !pgsIsland(ctx, isl)) continue;
     const Joint& j = w.joints_[i];
     items.push_back({Item::JointGroup, static_cast<std::int32_t>(i), solverIndex(ctx, j.def.body_a),
                      solverIndex(ctx, j.def.body_b), isl});
   }
   for (size_t i = 0; i < w.contacts_.size(); ++i) {
     const std::int32_t isl = ctx.contact_island[i];
-    if (!live(isl) || !pgs(isl)) continue;
+    if (!liveIsland(ctx, isl) || !pgsIsland(ctx, isl)) continue;
     const Contact& c = w.contacts_[i];
     const Item::Kind kind = usesRowGroup(c) ? Item::ContactGroup : Item::Manifold;
     items.push_back({kind, static_cast<std::int32_t>(i), solverIndex(ctx, c.body_a),
@@ -426,7 +423,18 @@ void layoutGraph(WorldImpl& w, StepContext& ctx) {
   g.batches.resize(static_cast<size_t>(batch_at));
   g.groups.resize(static_cast<size_t>(group_at));
   ctx.group_joint.assign(static_cast<size_t>(group_at), 0);
+  // Each manifold's lane, in level order within its colour.
   ctx.lane_contact.assign(static_cast<size_t>(batch_at) * kBatchLanes, -1);
+  std::vector<std::int32_t>& lane_fill = ctx.lane_fill;
+  lane_fill.resize(static_cast<size_t>(colours));
+  for (std::int32_t c = 0; c < colours; ++c) lane_fill[static_cast<size_t>(c)] = g.colours[static_cast<size_t>(c)].batch_begin * kBatchLanes;
+  for (size_t k = 0; k < sorted.size(); ++k) {
+    const Item& it = sorted[k];
+    if (it.kind != Item::Manifold) continue;
+    const std::int32_t slot = lane_fill[static_cast<size_t>(ctx.colour_of[k])]++;
+    ctx.lane_contact[static_cast<size_t>(slot)] = it.index;
+    g.batches[static_cast<size_t>(slot / kBatchLanes)].island[slot % kBatchLanes] = it.island;
+  }
 }
 
 }  // namespace
@@ -462,8 +470,6 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   ctx.rows.clear();
   ctx.island_rows.assign(static_cast<size_t>(ctx.island_count), {0, 0});
   for (int& k : w.stats_.rows_by_kind) k = 0;
-  const auto live = [&](std::int32_t isl) { return liveIsland(ctx, isl); };
-  const auto pgs = [&](std::int32_t isl) { return pgsIsland(ctx, isl); };
   const std::vector<Item>& sorted = ctx.sorted_items;
   const auto colours = static_cast<std::int32_t>(g.colours.size());
 
@@ -510,22 +516,15 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   };
   ctx.island_pushing.assign(static_cast<size_t>(ctx.island_count), 0);
 
-  std::vector<std::int32_t>&group_fill = ctx.group_fill, &lane_fill = ctx.lane_fill;
+  // The row groups, at this substep's pose (the manifolds have their lanes
+  // from layoutGraph, and are filled below).
+  std::vector<std::int32_t>& group_fill = ctx.group_fill;
   group_fill.resize(static_cast<size_t>(colours));
-  lane_fill.resize(static_cast<size_t>(colours));
-  for (std::int32_t c = 0; c < colours; ++c) {
-    group_fill[static_cast<size_t>(c)] = g.colours[static_cast<size_t>(c)].group_begin;
-    lane_fill[static_cast<size_t>(c)] = g.colours[static_cast<size_t>(c)].batch_begin * kBatchLanes;
-  }
+  for (std::int32_t c = 0; c < colours; ++c) group_fill[static_cast<size_t>(c)] = g.colours[static_cast<size_t>(c)].group_begin;
   for (size_t k = 0; k < sorted.size(); ++k) {
     const Item& it = sorted[k];
+    if (it.kind == Item::Manifold) continue;
     const size_t c = static_cast<size_t>(ctx.colour_of[k]);
-    if (it.kind == Item::Manifold) {  // its lane now, filled below
-      const std::int32_t slot = lane_fill[c]++;
-      ctx.lane_contact[static_cast<size_t>(slot)] = it.index;
-      g.batches[static_cast<size_t>(slot / kBatchLanes)].island[slot % kBatchLanes] = it.island;
-      continue;
-    }
     const std::int32_t gi = group_fill[c]++;
     RowGroup& grp = g.groups[static_cast<size_t>(gi)];
     grp.begin = static_cast<std::int32_t>(g.rows.size());
@@ -558,13 +557,13 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   const auto fillBatch = [&](ContactBatchInput& in, ContactBatch& batch, int bi) {
     for (int lane = 0; lane < kBatchLanes; ++lane) {
       const std::int32_t ci = ctx.lane_contact[static_cast<size_t>(bi) * kBatchLanes + static_cast<size_t>(lane)];
-      if (ci < 0) {  // the rest of a colour's last batch: the world on both sides, no points
-        gatherLane(in, batch, lane, Contact{}, BodyView{}, BodyView{}, 0);
+      if (ci < 0) {
+        gatherLane(in, batch, lane, kPadding, BodyView{}, BodyView{}, 0, w);
         continue;
       }
       const Contact& con = w.contacts_[static_cast<size_t>(ci)];
       gatherLane(in, batch, lane, con, solverView(w, ctx, con.body_a), solverView(w, ctx, con.body_b),
-                 batch.island[lane]);
+                 batch.island[lane], w);
     }
     kernels.fill(batch, in, fp);
     factorBatch(batch);
@@ -582,7 +581,6 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   const auto refreshBatch = [&](ContactBatchInput& in, ContactBatch& batch, int bi) {
     for (int lane = 0; lane < kBatchLanes; ++lane) {
       const std::int32_t ci = ctx.lane_contact[static_cast<size_t>(bi) * kBatchLanes + static_cast<size_t>(lane)];
-      static const Contact kPadding;  // the world on both sides, no points
       gatherPoses(in, lane, ci < 0 ? kPadding : w.contacts_[static_cast<size_t>(ci)], w);
     }
     kernels.refresh(batch, in, fp);
@@ -612,10 +610,10 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   // in one exact solve, so joints keep it in rhs.
   ctx.island_start.assign(static_cast<size_t>(ctx.island_count) + 1, 0);
   bool any_other = false;
-  for (std::int32_t isl = 0; isl < ctx.island_count; ++isl) any_other = any_other || (live(isl) && !pgs(isl));
+  for (std::int32_t isl = 0; isl < ctx.island_count; ++isl) any_other = any_other || (liveIsland(ctx, isl) && !pgsIsland(ctx, isl));
   if (any_other) {
     for (std::int32_t isl = 0; isl < ctx.island_count; ++isl) {
-      if (!live(isl) || pgs(isl)) continue;
+      if (!liveIsland(ctx, isl) || pgsIsland(ctx, isl)) continue;
       const auto begin = static_cast<std::int32_t>(ctx.rows.size());
       for (size_t i = 0; i < w.joints_.size(); ++i)
         if (ctx.joint_island[i] == isl) jointRows(static_cast<std::int32_t>(i), ctx.rows, Correction::InRhs);

@@ -458,7 +458,19 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   // if a guard has stopped an island or a joint has broken since.
   const bool same_graph = !first_substep && !ctx.any_frozen && w.break_events_.empty();
   const bool refresh_lanes = same_graph && !s.prepare_contacts_each_substep;
+  const bool last_substep = ctx.substep + 1 == s.substeps;
   GraphProblem& g = ctx.graph;
+  // Refreshed lanes carry their impulses from substep to substep, ahead of
+  // the contact cache (storeImpulses); lanes about to be prepared anew read
+  // the cache, so it catches up first. (At a step's first substep nothing
+  // is ahead: the lanes left by a step that threw may name contacts that
+  // are gone.)
+  if (first_substep) {
+    ctx.lanes_unstored = false;
+  } else if (ctx.lanes_unstored &&
+             (!refresh_lanes || (last_substep && std::any_of(g.batches.begin(), g.batches.end(), anyBounce)))) {
+    storeLaneImpulses(w, ctx);
+  }
   if (same_graph) {
     g.rows.clear();  // the row groups are built again below, at this substep's pose
     g.flow.reset();
@@ -577,7 +589,6 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   // the bounce with more energy than it brought (a box at restitution 1,
   // 0.2 to 0.5%, tests/unit/restitution_energy_test.cpp). Without a bounce
   // target a visit only removes energy, whatever its Jacobian.
-  const bool last_substep = ctx.substep + 1 == s.substeps;
   const auto refreshBatch = [&](ContactBatchInput& in, ContactBatch& batch, int bi) {
     for (int lane = 0; lane < kBatchLanes; ++lane) {
       const std::int32_t ci = ctx.lane_contact[static_cast<size_t>(bi) * kBatchLanes + static_cast<size_t>(lane)];

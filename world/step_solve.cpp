@@ -191,15 +191,20 @@ void applyRestitution(WorldImpl& w, StepContext& ctx) {
 
 namespace {
 
+// An island whose constraints were not solved this substep: none (-1), or
+// one a guard stopped.
+bool stoppedIsland(const StepContext& ctx, std::int32_t isl) {
+  return isl < 0 || (ctx.any_frozen && ctx.frozen_island[static_cast<size_t>(isl)]);
+}
+
 // One manifold lane's impulses back into its contact (nothing for padding
 // or a stopped island).
-template <class Stopped>
-void storeLane(WorldImpl& w, const StepContext& ctx, size_t slot, const Stopped& stopped) {
+void storeLane(WorldImpl& w, const StepContext& ctx, size_t slot) {
   const std::int32_t ci = ctx.lane_contact[slot];
   if (ci < 0) return;
   const ContactBatch& b = ctx.graph.batches[slot / kBatchLanes];
   const int l = static_cast<int>(slot % kBatchLanes);
-  if (stopped(b.island[l])) return;
+  if (stoppedIsland(ctx, b.island[l])) return;
   Contact& c = w.contacts_[static_cast<size_t>(ci)];
   const Vec3 n = c.normal;
   for (int i = 0; i < c.count; ++i) {
@@ -214,13 +219,25 @@ void storeLane(WorldImpl& w, const StepContext& ctx, size_t slot, const Stopped&
 
 }  // namespace
 
+void storeLaneImpulses(WorldImpl& w, StepContext& ctx) {
+  // Each lane writes its own contact (on the pool's threads when there are
+  // many).
+  const auto storeLanes = [&](int begin, int end) {
+    for (int k = begin; k < end; ++k) storeLane(w, ctx, static_cast<size_t>(k));
+  };
+  const int slots = static_cast<int>(ctx.lane_contact.size());
+  if (w.pool_ && slots >= kParallelLanes) w.pool_->parallelFor(slots, storeLanes);
+  else storeLanes(0, slots);
+  ctx.lanes_unstored = false;
+}
+
 void storeImpulses(WorldImpl& w, StepContext& ctx) {
   const Real h = ctx.hs;
   for (Joint& j : w.joints_) {
     std::fill(j.warm.begin(), j.warm.end(), Real(0));
     j.feedback = JointFeedback{};
   }
-  const auto stopped = [&](std::int32_t isl) { return isl < 0 || (ctx.any_frozen && ctx.frozen_island[static_cast<size_t>(isl)]); };
+  const auto stopped = [&](std::int32_t isl) { return stoppedIsland(ctx, isl); };
   // Row groups: joints, and contacts with rolling friction.
   const GraphProblem& g = ctx.graph;
   for (size_t gi = 0; gi < g.groups.size(); ++gi) {
@@ -233,14 +250,12 @@ void storeImpulses(WorldImpl& w, StepContext& ctx) {
       storeContactImpulses(w.contacts_[static_cast<size_t>(-1 - owner)], g.rows);
     }
   }
-  // Manifold lanes, each writing its own contact (on the pool's threads
-  // when there are many).
-  const auto storeLanes = [&](int begin, int end) {
-    for (int k = begin; k < end; ++k) storeLane(w, ctx, static_cast<size_t>(k), stopped);
-  };
-  const int slots = static_cast<int>(ctx.lane_contact.size());
-  if (w.pool_ && slots >= kParallelLanes) w.pool_->parallelFor(slots, storeLanes);
-  else storeLanes(0, slots);
+  // Manifold lanes: after the last substep, or before it when the next
+  // substep prepares them anew; else the next substep refreshes them with
+  // the impulses they hold, and the cache catches up later (the last
+  // substep, or prepareConstraints before it prepares any anew).
+  if (ctx.substep + 1 == w.settings_.substeps || w.settings_.prepare_contacts_each_substep) storeLaneImpulses(w, ctx);
+  else ctx.lanes_unstored = true;
   // Generic rows of the other islands.
   for (const ConstraintRow& r : ctx.rows) storeJointRow(w, r, h);
   for (size_t ci = 0; ci < w.contacts_.size(); ++ci) {

@@ -31,8 +31,15 @@ void solveConstraints(WorldImpl& w, StepContext& ctx);
 const ContactKernels& contactKernelsFor(const SolverSettings& s);
 // x += h v, q <- exp(h w) q, with the split-impulse pseudo-velocities.
 void integratePositions(WorldImpl& w, StepContext& ctx);
-// Impulses kept for warm starting, joint feedback, joints that break.
+// Impulses kept for warm starting, joint feedback, joints that break. The
+// contact lanes' impulses go back to the contact cache after the last
+// substep; before it only where each substep prepares its contacts anew,
+// since refreshed lanes carry their impulses themselves (else
+// StepContext::lanes_unstored says the cache is behind them).
 void storeImpulses(WorldImpl& w, StepContext& ctx);
+// The contact lanes' impulses into the contact cache (the islands a guard
+// stopped keep theirs); clears StepContext::lanes_unstored.
+void storeLaneImpulses(WorldImpl& w, StepContext& ctx);
 // Restitution, once per step after the last substep (world/step_solve.cpp).
 void applyRestitution(WorldImpl& w, StepContext& ctx);
 // Contact begin/end events (world/world_contacts.cpp).

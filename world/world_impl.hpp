@@ -167,6 +167,9 @@ struct StepContext {
   std::vector<Real> start_energy;
   std::vector<char> frozen_island;
   bool any_frozen = false;
+  // The contact lanes hold impulses the contact cache does not have yet
+  // (refreshed substeps: storeImpulses leaves them in the lanes).
+  bool lanes_unstored = false;
 
   // Scratch.
   std::vector<std::int32_t> island_start, island_fill, island_root, wake_list, sleep_first;

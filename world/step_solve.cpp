@@ -237,12 +237,11 @@ void storeImpulses(WorldImpl& w, StepContext& ctx) {
     std::fill(j.warm.begin(), j.warm.end(), Real(0));
     j.feedback = JointFeedback{};
   }
-  const auto stopped = [&](std::int32_t isl) { return stoppedIsland(ctx, isl); };
   // Row groups: joints, and contacts with rolling friction.
   const GraphProblem& g = ctx.graph;
   for (size_t gi = 0; gi < g.groups.size(); ++gi) {
     const RowGroup& grp = g.groups[gi];
-    if (stopped(grp.island)) continue;
+    if (stoppedIsland(ctx, grp.island)) continue;
     const std::int32_t owner = ctx.group_joint[gi];
     if (owner >= 0) {
       for (std::int32_t k = grp.begin; k < grp.end; ++k) storeJointRow(w, g.rows[static_cast<size_t>(k)], h);
@@ -250,17 +249,17 @@ void storeImpulses(WorldImpl& w, StepContext& ctx) {
       storeContactImpulses(w.contacts_[static_cast<size_t>(-1 - owner)], g.rows);
     }
   }
-  // Manifold lanes: after the last substep, or before it when the next
-  // substep prepares them anew; else the next substep refreshes them with
-  // the impulses they hold, and the cache catches up later (the last
-  // substep, or prepareConstraints before it prepares any anew).
+  // Manifold lanes: after the last substep, and after every substep where
+  // each prepares its contacts anew. Refreshed lanes carry their impulses
+  // into the next substep instead, and the cache catches up after the last
+  // one, or in prepareConstraints before it prepares any lane anew.
   if (ctx.substep + 1 == w.settings_.substeps || w.settings_.prepare_contacts_each_substep) storeLaneImpulses(w, ctx);
   else ctx.lanes_unstored = true;
   // Generic rows of the other islands.
   for (const ConstraintRow& r : ctx.rows) storeJointRow(w, r, h);
   for (size_t ci = 0; ci < w.contacts_.size(); ++ci) {
     const std::int32_t isl = ctx.contact_island[ci];
-    if (!stopped(isl) && ctx.island_method[static_cast<size_t>(isl)] != SolverMethod::PGS)
+    if (!stoppedIsland(ctx, isl) && ctx.island_method[static_cast<size_t>(isl)] != SolverMethod::PGS)
       storeContactImpulses(w.contacts_[ci], ctx.rows);
   }
   // Joints that break: force or torque past the threshold.

@@ -317,13 +317,7 @@ TEST(JointFeedback, EqualsTheBodysMomentumChangeWhenTheBiasIsInTheRows) {
   w.setSettings(s);
   const Vec3 anchor(0, 10, 0);
   const BodyId id = w.createBody(test::sphereDef("bob", anchor - Vec3(1, 0, 0), 1, 0.1));
-  JointDef j;
-  j.name = "pivot";
-  j.type = JointType::Ball;
-  j.body_a = kWorldBody;
-  j.body_b = id;
-  j.anchor = anchor;
-  const JointId jid = w.createJoint(j);
+  const JointId jid = w.createJoint(test::ballToWorld("pivot", id, anchor));
   Real largest = 0;
   for (int k = 0; k < 60; ++k) {
     const Vec3 v0 = w.linearVelocity(id);

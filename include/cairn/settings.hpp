@@ -71,17 +71,17 @@ struct SolverSettings {
   bool nncg = true;             ///< PGS with NNCG momentum between sweeps (solver/pgs.cpp); false: plain PGS as Bullet
   std::uint64_t seed = 1;       ///< seed of the random row order (randomize_order): same seed, same run
   int substeps = 1;             ///< sub-steps per step
-  /// With substeps: true (default), every substep prepares its contacts
-  /// anew at its own pose (anchors, tangents, effective masses, the normal
-  /// block); false, each manifold is prepared once per step and later
-  /// substeps only refresh each point's separation and targets from the
-  /// bodies' new poses, as Box2D v3's solver.c does: cheaper, but a body
-  /// that turns within the step is pushed along anchors a substep old (a
+  /// With substeps: false (default), each manifold is prepared once per
+  /// step and later substeps only refresh each point's separation and
+  /// targets from the bodies' new poses, as Box2D v3's solver.c does (a
   /// batch with a bouncing point is prepared anew on the last substep, so
-  /// that restitution adds no energy; docs/performance.md measures both).
-  /// Either way the graph's layout (order, colours, lanes) is made once
-  /// per step.
-  bool prepare_contacts_each_substep = true;
+  /// that restitution adds no energy); true, every substep prepares its
+  /// contacts anew at its own pose (anchors, tangents, effective masses,
+  /// the normal block): dearer, and a body that turns within the step is
+  /// then pushed along anchors of its present pose rather than a substep
+  /// old. docs/performance.md measures both. Either way the graph's layout
+  /// (order, colours, lanes) is made once per step.
+  bool prepare_contacts_each_substep = false;
   int threads = 1;              ///< worker threads for the step (results are bit-identical for any count); while they lose their cores to other work the step runs on one (StepStats::threads)
   Simd simd = Simd::Auto;       ///< contact solver instruction set
   bool compute_residual = false;  ///< fill StepStats::residual (one extra pass over the rows)

@@ -466,19 +466,23 @@ TEST(Determinism, JointsInLanesGiveTheBitsOfEachJointAlone) {
     expectLanesGiveTheBitsOfJointsAlone(w, p, bestSimdLevel(), true, Real(1e-2));
 }
 
-// Contacts prepared once per step and refreshed at later substeps
-// (SolverSettings::prepare_contacts_each_substep false): pyramid-20's 111
-// batches are refreshed on the pool's threads, and by each kernel level's
-// refresh, with one set of bits.
-TEST(Determinism, RefreshedContactsAreBitIdenticalOnAnyThreadsAndKernels) {
-  SceneDesc s = scenarios::pyramid(20);
-  s.solver.substeps = 4;
-  s.solver.iterations = 3;
-  s.solver.prepare_contacts_each_substep = false;
-  const auto one = run(s, 20, 1, Simd::Portable);
-  expectIdentical(one, run(s, 20, 2, Simd::Portable));
-  if (simdLevelAvailable(SimdLevel::Avx2)) expectIdentical(one, run(s, 20, 2, Simd::Avx2));
-  if (simdLevelAvailable(SimdLevel::Avx512)) expectIdentical(one, run(s, 20, 1, Simd::Avx512));
+// Contacts over substeps, both ways (SolverSettings::
+// prepare_contacts_each_substep): refreshed at later substeps (the
+// default), pyramid-20's 111 batches are refreshed on the pool's threads
+// and by each kernel level's refresh; prepared anew, they are filled
+// again; either way with one set of bits.
+TEST(Determinism, ContactsOverSubstepsAreBitIdenticalOnAnyThreadsAndKernels) {
+  for (const bool prepare_each : {false, true}) {
+    SCOPED_TRACE(prepare_each ? "prepared each substep" : "refreshed");
+    SceneDesc s = scenarios::pyramid(20);
+    s.solver.substeps = 4;
+    s.solver.iterations = 3;
+    s.solver.prepare_contacts_each_substep = prepare_each;
+    const auto one = run(s, 20, 1, Simd::Portable);
+    expectIdentical(one, run(s, 20, 2, Simd::Portable));
+    if (simdLevelAvailable(SimdLevel::Avx2)) expectIdentical(one, run(s, 20, 2, Simd::Avx2));
+    if (simdLevelAvailable(SimdLevel::Avx512)) expectIdentical(one, run(s, 20, 1, Simd::Avx512));
+  }
 }
 
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {

@@ -74,6 +74,10 @@ TEST(ExtremesSize, Column50WithSubsteps) { expectHolds("column-50", "pgs 20 it x
 TEST(ExtremesSize, HangingChain1000WithDirectSubsteps) {
   expectHolds("hanging-chain-1000", "direct x 4 sub");
 }
+// 1 mm cubes (1 mg): the criterion in box sizes. They hold with their
+// contacts prepared once per step and refreshed at each substep (the
+// default); prepared anew at every substep they collapse (13 box sizes).
+TEST(ExtremesSize, MillimetreCubesWithSubsteps) { expectHolds("column-10-1mm", "pgs 20 it x 8 sub"); }
 // 100 m cubes: the criterion in box sizes (5 cm per metre of box).
 TEST(ExtremesSize, HundredMetreCubesAtDefault) { expectHolds("column-5-100m", "default"); }
 

@@ -30,6 +30,16 @@ BodyDef solid(const std::string& name, Real mass, const Vec3& position, ShapeDes
   return b;
 }
 
+JointDef joint(const std::string& name, JointType type, BodyId a, BodyId b, const Vec3& anchor) {
+  JointDef j;
+  j.name = name;
+  j.type = type;
+  j.body_a = a;
+  j.body_b = b;
+  j.anchor = anchor;
+  return j;
+}
+
 BodyDef ground() {
   BodyDef g;
   g.name = "ground";
@@ -71,13 +81,8 @@ SceneDesc chain(int n) {
     b.collision_group = 2;  // no collision within the chain
     b.collision_mask = ~2u;
     s.bodies.push_back(b);
-    JointDef j;
-    j.name = "ball_" + std::to_string(k);
-    j.type = JointType::Ball;
-    j.body_a = k == 0 ? kWorldBody : BodyId{k - 1};
-    j.body_b = BodyId{k};
-    j.anchor = Vec3(Real(k), 0, 0);
-    s.joints.push_back(j);
+    s.joints.push_back(joint("ball_" + std::to_string(k), JointType::Ball, k == 0 ? kWorldBody : BodyId{k - 1},
+                             BodyId{k}, Vec3(Real(k), 0, 0)));
   }
   return s;
 }
@@ -94,13 +99,8 @@ SceneDesc hangingChain(int n) {
     b.collision_group = 2;
     b.collision_mask = ~2u;
     s.bodies.push_back(b);
-    JointDef j;
-    j.name = "ball_" + std::to_string(k);
-    j.type = JointType::Ball;
-    j.body_a = k == 0 ? kWorldBody : BodyId{k - 1};
-    j.body_b = BodyId{k};
-    j.anchor = Vec3(0, -Real(0.5) * k, 0);
-    s.joints.push_back(j);
+    s.joints.push_back(joint("ball_" + std::to_string(k), JointType::Ball, k == 0 ? kWorldBody : BodyId{k - 1},
+                             BodyId{k}, Vec3(0, -Real(0.5) * k, 0)));
   }
   return s;
 }
@@ -110,12 +110,7 @@ SceneDesc hingePendulum(Real amplitude) {
   BodyDef b = box("bob", Vec3(std::sin(amplitude), -std::cos(amplitude), 0));
   b.orientation = Quat(Eigen::AngleAxis<Real>(amplitude, Vec3::UnitZ()));
   s.bodies.push_back(b);
-  JointDef j;
-  j.name = "hinge";
-  j.type = JointType::Hinge;
-  j.body_a = kWorldBody;
-  j.body_b = BodyId{0};
-  j.anchor = Vec3::Zero();
+  JointDef j = joint("hinge", JointType::Hinge, kWorldBody, BodyId{0}, Vec3::Zero());
   j.axis = Vec3::UnitZ();
   s.joints.push_back(j);
   return s;
@@ -227,12 +222,7 @@ BodyDef cuboid(const std::string& name, Real mass, const Vec3& p, const Vec3& ha
 }
 
 JointDef hinge(const std::string& name, BodyId a, BodyId b, const Vec3& anchor, const Vec3& axis) {
-  JointDef j;
-  j.name = name;
-  j.type = JointType::Hinge;
-  j.body_a = a;
-  j.body_b = b;
-  j.anchor = anchor;
+  JointDef j = joint(name, JointType::Hinge, a, b, anchor);
   j.axis = axis;
   return j;
 }

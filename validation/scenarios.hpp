@@ -52,6 +52,10 @@ SceneDesc sideBySide(const SceneDesc& one, int copies, const Vec3& offset);
 // A dynamic body of one shape (friction 0.5, the BodyDef default).
 BodyDef solid(const std::string& name, Real mass, const Vec3& position, ShapeDesc shape);
 
+// A joint of `type` between a and b (kWorldBody for the world) at the world
+// point `anchor`; its axis, limits and motor are the JointDef defaults.
+JointDef joint(const std::string& name, JointType type, BodyId a, BodyId b, const Vec3& anchor);
+
 // Static ground: a box 200 x 1 x 200 m whose top face is y = 0 (Bullet
 // compares best with a box ground; a plane behaves the same in cairn).
 BodyDef ground();

@@ -317,7 +317,7 @@ TEST(JointFeedback, EqualsTheBodysMomentumChangeWhenTheBiasIsInTheRows) {
   w.setSettings(s);
   const Vec3 anchor(0, 10, 0);
   const BodyId id = w.createBody(test::sphereDef("bob", anchor - Vec3(1, 0, 0), 1, 0.1));
-  const JointId jid = w.createJoint(test::ballToWorld("pivot", id, anchor));
+  const JointId jid = w.createJoint(scenarios::joint("pivot", JointType::Ball, kWorldBody, id, anchor));
   Real largest = 0;
   for (int k = 0; k < 60; ++k) {
     const Vec3 v0 = w.linearVelocity(id);

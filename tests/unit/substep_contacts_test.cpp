@@ -93,7 +93,7 @@ TEST(SubstepContacts, RefreshHandsItsImpulsesOnWhenAJointBreaksWithinAStep) {
     for (int k = 0; k < 3; ++k) {
       const Vec3 anchor(20 + 3 * k, 10, 0);  // 9 m over the ground: no landing within the run
       const BodyId bob = w.createBody(test::sphereDef("bob" + std::to_string(k), anchor - Vec3(1, 0, 0), 1, 0.1));
-      JointDef j = test::ballToWorld("hook" + std::to_string(k), bob, anchor);
+      JointDef j = scenarios::joint("hook" + std::to_string(k), JointType::Ball, kWorldBody, bob, anchor);
       j.break_force = (0.3 + 0.2 * k) * 9.81;
       w.createJoint(j);
     }

@@ -63,17 +63,6 @@ inline BodyDef sphereDef(const std::string& name, const Vec3& pos, Real mass = 1
   return scenarios::solid(name, mass, pos, ShapeDesc::sphere(r));
 }
 
-// A ball joint holding `body` from the world at `anchor`.
-inline JointDef ballToWorld(const std::string& name, BodyId body, const Vec3& anchor) {
-  JointDef j;
-  j.name = name;
-  j.type = JointType::Ball;
-  j.body_a = kWorldBody;
-  j.body_b = body;
-  j.anchor = anchor;
-  return j;
-}
-
 // A world that never sleeps (default gravity: none), for tests that follow
 // motions slowing below the sleep thresholds.
 inline World awakeWorld(const Vec3& gravity = Vec3::Zero()) {

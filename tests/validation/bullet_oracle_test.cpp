@@ -436,13 +436,7 @@ TEST(BulletOracle, EveryJointTypeBuildsAndHolds) {
     return BodyId{static_cast<std::int32_t>(scene.bodies.size() - 1)};
   };
   const auto joint = [&](JointType type, const std::string& name, BodyId a, BodyId b, const Vec3& anchor) {
-    JointDef j;
-    j.type = type;
-    j.name = name;
-    j.body_a = a;
-    j.body_b = b;
-    j.anchor = anchor;
-    scene.joints.push_back(j);
+    scene.joints.push_back(scenarios::joint(name, type, a, b, anchor));
     return &scene.joints.back();
   };
   joint(JointType::Ball, "ball", kWorldBody, add("b0", Vec3(0, -0.5, 0)), Vec3(0.3, 0, 0));

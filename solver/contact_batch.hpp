@@ -26,7 +26,9 @@
 // explains why): the block's matrix A_b = J_b M^-1 J_b^T + diag(cfm) and its
 // Cholesky factor L are stored per lane, padded to 4 x 4 with identity rows
 // for missing points. Friction is two tangent rows per point, t and n x t,
-// each bounded by mu lambda_n of its point (ODE's and Bullet's pyramid).
+// each bounded by mu lambda_n of its point (ODE's and Bullet's pyramid), or
+// with SolverSettings::patch_friction one patch per manifold: two tangent
+// rows at the points' centre and a twist row about the normal (below).
 #pragma once
 
 #include <cstdint>
@@ -83,6 +85,24 @@ struct alignas(64) ContactBatch {
   Lanes block[10];
   Lanes factor[10];
 
+  // Friction per manifold patch (SolverSettings::patch_friction, as
+  // ReactPhysics3D's contact solver and bepuphysics2's TangentFriction and
+  // TwistFriction do it): the manifold's friction is two tangent rows at the
+  // centre c of its points and one twist row about the normal, instead of
+  // rows at every point. The tangent rows live in point 0's tangent fields
+  // (t, ra and rb: the anchors of c, tangent_mass, lambda_t, change_t,
+  // dir_t; the other points' stay zero) and are solved as one 2 x 2 block,
+  // their impulse clamped to the disc of radius mu sum_i lambda_i (the
+  // Coulomb cone of the patch's total load). The twist row J = (0, -n, 0, n)
+  // is bounded by mu sum_i lambda_i d_i, d_i the point's distance from c in
+  // the contact plane (each point's share of the load resisting turning
+  // with its lever arm).
+  Lanes patch_mass[3];  // inverse of the tangent rows' 2 x 2 block (+ cfm): 00, 01, 11
+  Lanes twist_mass;     // 1 / (n . (I_a^-1 + I_b^-1) n + cfm); 0: no twist row
+  Lanes lambda_twist;   // accumulated twist impulse (warm-started)
+  Lanes change_twist, dir_twist;  // NNCG, as the points' change_t and dir_t
+  Lanes arm[kMaxPoints];          // d_i
+
   // Per lane, written by every sweep: the largest impulse change and the
   // largest impulse (the per-island stopping test), and for NNCG the
   // squared norm of the changes.
@@ -128,6 +148,7 @@ struct ContactFillParams {
   bool in_rhs = false;        // the push-out in the velocity target (Baumgarte), not the correction pass
   bool first_substep = true;  // restitution's largest impulse starts over
   int friction_rows = 2;      // tangent rows per point
+  bool patch = false;         // friction per manifold patch (friction_rows is then not read)
 };
 
 // What a kernel sweep needs besides the batches.
@@ -136,6 +157,7 @@ struct ContactSweepParams {
   int dynamic_end = 1;  // solver bodies [1, dynamic_end) may be written; 0 (the world) and the rest are read only
   bool gather_change = false;  // NNCG: record each row's change and the lane's squared norm
   int friction_rows = 2;       // tangent rows per point (SolverSettings::friction_directions)
+  bool patch = false;          // friction per manifold patch (SolverSettings::patch_friction)
   // Per island: 1 while its sweeps go on, 0 once it has stopped (its lanes
   // are left as they are). Null: every island goes on.
   const double* island_active = nullptr;

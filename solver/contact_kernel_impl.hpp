@@ -28,6 +28,11 @@
 //   friction        per point, t then n x t, each a row:
 //                   l' = clamp(l + sor (-J v - cfm l) / (A_tt + cfm),
 //                              -mu lambda_n, mu lambda_n)
+//   patch friction  per manifold (contact_batch.hpp): the tangent pair at
+//                   the centre as a 2 x 2 block K (+ cfm),
+//                   l' = proj_disc(l - sor K^-1 (J v + cfm l), mu sum lambda_n),
+//                   then the twist row, J v = n . (w_b - w_a),
+//                   clamped to +-mu sum lambda_n,i d_i
 #pragma once
 
 #include "solver/contact_kernels.hpp"
@@ -299,6 +304,27 @@ struct Kernel {
     s.wb = add(s.wb, mulS(m.ib, sum.tb));
   }
 
+  // Patch friction: the pair (l0, l1) scaled back onto the disc of radius
+  // `limit` when outside it (the Coulomb cone; limit >= 0).
+  CAIRN_INLINE void clampDisc(D& l0, D& l1, D limit) {
+    const D mag2 = l0 * l0 + l1 * l1;
+    const M over = mag2 > limit * limit;
+    const D scale = sel(over, limit / vsqrt(sel(over, mag2, splat(1))), splat(1));
+    l0 = l0 * scale;
+    l1 = l1 * scale;
+  }
+  // The patch's bounds from its points' normal impulses: mu sum lambda_i
+  // for the tangent pair, mu sum lambda_i d_i for the twist.
+  CAIRN_INLINE void patchLimits(const ContactBatch& b, int o, int points, D mu, const D* lam, D& limit, D& twist_limit) {
+    D total = zero(), load = zero();
+    for (int i = 0; i < points; ++i) {
+      total += lam[i];
+      load += lam[i] * ld(b.arm[i] + o);
+    }
+    limit = mu * total;
+    twist_limit = mu * load;
+  }
+
   // Projected sweeps on a block whose points do not all push. Two, not the
   // scalar solver's 32 (pgs.cpp): the block solve is one visit of an outer
   // Gauss-Seidel sweep that comes back to it anyway, and in a vector of
@@ -387,14 +413,16 @@ struct Kernel {
         for (int i = 0; i < points; ++i) {
           const ContactBatch::Point& q = b.p[i];
           addRow(sum, n, ld3(q.ran, o), ld3(q.rbn, o), ld(q.lambda + o));
+          if (p.patch && i > 0) continue;  // the patch's rows are point 0's
           const V3 t1 = ld3(q.t, o), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
           // The tangent rows in use (a row past friction_rows holds zeros: it would add nothing).
           addRow(sum, t1, cross(ra, t1), cross(rb, t1), ld(q.lambda_t[0] + o));
-          if (p.friction_rows > 1) {
+          if (p.friction_rows > 1 || p.patch) {
             const V3 t2 = cross(n, t1);
             addRow(sum, t2, cross(ra, t2), cross(rb, t2), ld(q.lambda_t[1] + o));
           }
         }
+        if (p.patch) addRow(sum, zero3(), n, n, ld(b.lambda_twist + o));
         applySum(s, m, sum);
         scatter(bodies, b, o, s, p.dynamic_end, allTrue());
       }
@@ -474,6 +502,52 @@ struct Kernel {
     }
   }
 
+  // One visit of lanes [o, o + W)'s friction patches (solveFriction with
+  // SolverSettings::patch_friction): the tangent pair at the centre solved
+  // as its 2 x 2 block from the same velocities and projected on the disc,
+  // then the twist row against the velocities the pair left.
+  CAIRN_INLINE void patchVisit(ContactBatch& b, int o, Pair& s, const Mass& m, const V3& n, D cfm, D mu, int points, D sor,
+                               M active, bool gather, D& maxd, D& maxl, D& ch2) {
+    D lam[kMaxPoints];
+    for (int i = 0; i < points; ++i) lam[i] = ld(b.p[i].lambda + o);
+    D limit, twist_limit;
+    patchLimits(b, o, points, mu, lam, limit, twist_limit);
+    ContactBatch::Point& q = b.p[0];
+    const V3 t1 = ld3(q.t, o), t2 = cross(n, t1), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
+    const V3 ra1 = cross(ra, t1), rb1 = cross(rb, t1), ra2 = cross(ra, t2), rb2 = cross(rb, t2);
+    const D l0 = ld(q.lambda_t[0] + o), l1 = ld(q.lambda_t[1] + o);
+    const D v0 = rowVel(s, t1, ra1, rb1) + cfm * l0, v1 = rowVel(s, t2, ra2, rb2) + cfm * l1;
+    const D k00 = ld(b.patch_mass[0] + o), k01 = ld(b.patch_mass[1] + o), k11 = ld(b.patch_mass[2] + o);
+    D n0 = l0 - sor * (k00 * v0 + k01 * v1), n1 = l1 - sor * (k01 * v0 + k11 * v1);
+    clampDisc(n0, n1, limit);
+    n0 = sel(active, n0, l0);
+    n1 = sel(active, n1, l1);
+    const D d0 = n0 - l0, d1 = n1 - l1;
+    Sum sum{zero3(), zero3(), zero3()};
+    addRow(sum, t1, ra1, rb1, d0);
+    addRow(sum, t2, ra2, rb2, d1);
+    applySum(s, m, sum);
+    st(q.lambda_t[0] + o, n0);
+    st(q.lambda_t[1] + o, n1);
+    const D lt = ld(b.lambda_twist + o);
+    D nt = lt + sor * (-dot(n, sub(s.wb, s.wa)) - cfm * lt) * ld(b.twist_mass + o);
+    nt = vmin(vmax(nt, -twist_limit), twist_limit);
+    nt = sel(active, nt, lt);
+    const D dt = nt - lt;
+    const V3 nd = mul(n, dt);
+    s.wa = sub(s.wa, mulS(m.ia, nd));
+    s.wb = add(s.wb, mulS(m.ib, nd));
+    st(b.lambda_twist + o, nt);
+    maxd = vmax(maxd, vmax(vmax(vabs(d0), vabs(d1)), vabs(dt)));
+    maxl = vmax(maxl, vmax(vmax(vabs(n0), vabs(n1)), vabs(nt)));
+    if (gather) {
+      st(q.change_t[0] + o, d0);
+      st(q.change_t[1] + o, d1);
+      st(b.change_twist + o, dt);
+      ch2 += d0 * d0 + d1 * d1 + dt * dt;
+    }
+  }
+
   // One projected Gauss-Seidel visit of every manifold's friction rows,
   // after the normal pass of the same sweep: per point two tangent rows, t
   // then n x t, each bounded by mu lambda_n of its point (the friction
@@ -497,6 +571,14 @@ struct Kernel {
         const int points = maxPoints(b, o);
         D maxd = ld(b.sweep_delta + o), maxl = ld(b.sweep_lambda + o);
         D ch2 = p.gather_change ? ld(b.change2 + o) : zero();
+        if (p.patch) {
+          patchVisit(b, o, s, m, n, cfm, mu, points, sor, active, p.gather_change, maxd, maxl, ch2);
+          if (p.gather_change) st(b.change2 + o, ch2);
+          st(b.sweep_delta + o, maxd);
+          st(b.sweep_lambda + o, maxl);
+          scatter(bodies, b, o, s, p.dynamic_end, active);
+          continue;
+        }
         for (int i = 0; i < points; ++i) {
           ContactBatch::Point& q = b.p[i];
           const V3 t1 = ld3(q.t, o), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
@@ -527,6 +609,45 @@ struct Kernel {
     }
   }
 
+  // NNCG's momentum step of lanes [o, o + W) with patch friction: the
+  // normal impulses as per point, then the patch's pair projected on the
+  // disc and its twist on the bounds of the new normal impulses.
+  template <class NewDir>
+  CAIRN_INLINE void patchMomentum(ContactBatch& b, int o, const V3& n, D mu, int points, M apply, D bstep, NewDir&& newDir,
+                                  Sum& sum) {
+    D lam[kMaxPoints];
+    for (int i = 0; i < points; ++i) {
+      ContactBatch::Point& q = b.p[i];
+      const D l = ld(q.lambda + o), dir = ld(q.dir_n + o);
+      lam[i] = sel(apply, vmax(l + bstep * dir, zero()), l);
+      st(q.lambda + o, lam[i]);
+      st(q.max_lambda + o, vmax(ld(q.max_lambda + o), lam[i]));
+      st(q.dir_n + o, newDir(dir, ld(q.change_n + o)));
+      addRow(sum, n, ld3(q.ran, o), ld3(q.rbn, o), lam[i] - l);
+    }
+    D limit, twist_limit;
+    patchLimits(b, o, points, mu, lam, limit, twist_limit);
+    ContactBatch::Point& q = b.p[0];
+    const D l0 = ld(q.lambda_t[0] + o), l1 = ld(q.lambda_t[1] + o);
+    const D p0 = ld(q.dir_t[0] + o), p1 = ld(q.dir_t[1] + o);
+    D n0 = l0 + bstep * p0, n1 = l1 + bstep * p1;
+    clampDisc(n0, n1, limit);
+    n0 = sel(apply, n0, l0);
+    n1 = sel(apply, n1, l1);
+    st(q.lambda_t[0] + o, n0);
+    st(q.lambda_t[1] + o, n1);
+    st(q.dir_t[0] + o, newDir(p0, ld(q.change_t[0] + o)));
+    st(q.dir_t[1] + o, newDir(p1, ld(q.change_t[1] + o)));
+    const V3 t1 = ld3(q.t, o), t2 = cross(n, t1), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
+    addRow(sum, t1, cross(ra, t1), cross(rb, t1), n0 - l0);
+    addRow(sum, t2, cross(ra, t2), cross(rb, t2), n1 - l1);
+    const D lt = ld(b.lambda_twist + o), pt = ld(b.dir_twist + o);
+    const D nt = sel(apply, vmin(vmax(lt + bstep * pt, -twist_limit), twist_limit), lt);
+    st(b.lambda_twist + o, nt);
+    st(b.dir_twist + o, newDir(pt, ld(b.change_twist + o)));
+    addRow(sum, zero3(), n, n, nt - lt);
+  }
+
   // NNCG's momentum: lambda' = proj(lambda + beta p); the changes need no
   // velocity, so they are summed and reach the bodies once per manifold.
   static void momentum(ContactBatch* batches, int begin, int end, double* bodies, const double* island_beta,
@@ -547,9 +668,11 @@ struct Kernel {
           for (int i = 0; i < points; ++i) {
             ContactBatch::Point& q = b.p[i];
             st(q.dir_n + o, newDir(ld(q.dir_n + o), ld(q.change_n + o)));
-            for (int k = 0; k < p.friction_rows; ++k)
+            if (p.patch && i > 0) continue;
+            for (int k = 0; k < (p.patch ? 2 : p.friction_rows); ++k)
               st(q.dir_t[k] + o, newDir(ld(q.dir_t[k] + o), ld(q.change_t[k] + o)));
           }
+          if (p.patch) st(b.dir_twist + o, newDir(ld(b.dir_twist + o), ld(b.change_twist + o)));
           continue;
         }
         Pair s;
@@ -559,6 +682,12 @@ struct Kernel {
         const D mu = ld(b.mu + o);
         const D bstep = sel(apply, beta, zero());
         Sum sum{zero3(), zero3(), zero3()};
+        if (p.patch) {
+          patchMomentum(b, o, n, mu, points, apply, bstep, newDir, sum);
+          applySum(s, m, sum);
+          scatter(bodies, b, o, s, p.dynamic_end, apply);
+          continue;
+        }
         for (int i = 0; i < points; ++i) {
           ContactBatch::Point& q = b.p[i];
           const D l = ld(q.lambda + o), dir = ld(q.dir_n + o);
@@ -756,6 +885,8 @@ struct Kernel {
         st(q.dir_t[k] + o, zero_);
       }
     }
+    st(b.change_twist + o, zero_);
+    st(b.dir_twist + o, zero_);
   }
 
   // A later substep of a batch filled at the step's first (SolverSettings::
@@ -784,7 +915,99 @@ struct Kernel {
         st(q.lambda + o, sel(ok, warm * ld(q.lambda + o), zero_));
         for (int k = 0; k < 2; ++k) st(q.lambda_t[k] + o, warm * ld(q.lambda_t[k] + o));
       }
+      st(b.lambda_twist + o, warm * ld(b.lambda_twist + o));
     }
+  }
+
+  // The first tangent of a point (or a patch's centre) with relative
+  // velocity vrel and carried friction impulse fi: along the sliding
+  // direction when sliding, so the pyramid's corners do not favour axes;
+  // else along the carried friction impulse, else any perpendicular
+  // (anyPerpendicular in cairn/math.hpp: n x (x or y), normalised).
+  CAIRN_INLINE V3 tangent(const V3& n, const V3& vrel, const V3& fi) {
+    const D zero_ = zero(), one = splat(1);
+    const V3 vt = sub(vrel, mul(n, dot(n, vrel)));
+    const V3 carried = sub(fi, mul(n, dot(n, fi)));
+    const D vt2 = dot(vt, vt), carried2 = dot(carried, carried);
+    const M use_x = vabs(n.x) < 0.57735;
+    const V3 axis{sel(use_x, one, zero_), sel(use_x, zero_, one), zero_};
+    const V3 perp = cross(n, axis);
+    const D perp2 = dot(perp, perp);
+    const D rp = vsqrt(sel(perp2 > 0, perp2, one));
+    V3 t1 = sel3(perp2 > 0, V3{perp.x / rp, perp.y / rp, perp.z / rp}, perp);
+    const M carried_ok = carried2 > 1e-24;
+    const D rc = vsqrt(sel(carried_ok, carried2, one));
+    t1 = sel3(carried_ok, V3{carried.x / rc, carried.y / rc, carried.z / rc}, t1);
+    const M sliding = vt2 > 1e-6;
+    const D rv = vsqrt(sel(sliding, vt2, one));
+    return sel3(sliding, V3{vt.x / rv, vt.y / rv, vt.z / rv}, t1);
+  }
+
+  // A manifold's friction patch (contact_batch.hpp) from its points'
+  // anchors ra_i, rb_i and carried friction impulses f_i (zeros where no
+  // point): the centre c is the points' mean; the carried patch impulse
+  // is sum f_i and the carried twist sum n . (d_i x f_i), d_i = r_a,i - c,
+  // which is what the store's split of the patch's impulses over the
+  // points (world/step_solve.cpp) gives back.
+  CAIRN_INLINE void fillPatch(ContactBatch& b, int o, const ContactFillParams& p, const M* valid, const V3* ras,
+                              const V3* rbs, const V3* fis, const M3& ia, const M3& ib, const V3& m_ab, const V3& n, D mu,
+                              const V3& va, const V3& wa, const V3& vb, const V3& wb) {
+    const D zero_ = zero(), one = splat(1), cfm = splat(p.cfm), warm = splat(p.warm);
+    V3 ca = zero3(), cb = zero3(), carried = zero3();
+    D count = zero_;
+    for (int i = 0; i < kMaxPoints; ++i) {
+      ca = add(ca, sel3(valid[i], ras[i], zero3()));
+      cb = add(cb, sel3(valid[i], rbs[i], zero3()));
+      carried = add(carried, fis[i]);
+      count += sel(valid[i], one, zero_);
+    }
+    const M has = count > 0;
+    const D inv_count = one / sel(has, count, one);
+    ca = mul(ca, inv_count);
+    cb = mul(cb, inv_count);
+    const V3 vrel = sub(add(vb, cross(wb, cb)), add(va, cross(wa, ca)));
+    const V3 t1 = tangent(n, vrel, carried), t2 = cross(n, t1);
+    const V3 ra1 = cross(ca, t1), rb1 = cross(cb, t1), ra2 = cross(ca, t2), rb2 = cross(cb, t2);
+    const D k00 = dot(t1, cmul(m_ab, t1)) + dot(ra1, mulM(ia, ra1)) + dot(rb1, mulM(ib, rb1)) + cfm;
+    const D k11 = dot(t2, cmul(m_ab, t2)) + dot(ra2, mulM(ia, ra2)) + dot(rb2, mulM(ib, rb2)) + cfm;
+    const D k01 = dot(t1, cmul(m_ab, t2)) + dot(ra1, mulM(ia, ra2)) + dot(rb1, mulM(ib, rb2));
+    const D det = k00 * k11 - k01 * k01;
+    const M rubs = has & (mu > 0) & (k00 > 0) & (det > 0);
+    const D inv_det = one / sel(rubs, det, one);
+    ContactBatch::Point& q = b.p[0];
+    st3(q.t, o, t1);
+    st3(q.ra, o, sel3(rubs, ca, zero3()));
+    st3(q.rb, o, sel3(rubs, cb, zero3()));
+    st(q.tangent_mass[0] + o, sel(rubs, k00, zero_));  // inverted with the batch, as the per-point rows'
+    st(q.tangent_mass[1] + o, sel(rubs, k11, zero_));
+    st(b.patch_mass[0] + o, sel(rubs, k11 * inv_det, zero_));
+    st(b.patch_mass[1] + o, sel(rubs, -k01 * inv_det, zero_));
+    st(b.patch_mass[2] + o, sel(rubs, k00 * inv_det, zero_));
+    st(q.lambda_t[0] + o, sel(rubs, warm * dot(carried, t1), zero_));
+    st(q.lambda_t[1] + o, sel(rubs, warm * dot(carried, t2), zero_));
+    // The twist: lever arms in the contact plane, and its row's mass.
+    D arm2 = zero_, twist = zero_;
+    for (int i = 0; i < kMaxPoints; ++i) {
+      const V3 d = sub(ras[i], ca);
+      const V3 in_plane = sub(d, mul(n, dot(n, d)));
+      const D arm = sel(valid[i] & rubs, vsqrt(dot(in_plane, in_plane)), zero_);
+      st(b.arm[i] + o, arm);
+      arm2 += arm * arm;
+      twist += dot(fis[i], cross(n, d));
+    }
+    const D kt = dot(n, mulM(ia, n)) + dot(n, mulM(ib, n)) + cfm;
+    const M turns = rubs & (arm2 > 0) & (kt > 0);
+    st(b.twist_mass + o, sel(turns, one / sel(turns, kt, one), zero_));
+    st(b.lambda_twist + o, sel(turns, warm * twist, zero_));
+  }
+
+  // Per-point friction: the patch's fields hold zeros.
+  CAIRN_INLINE void clearPatch(ContactBatch& b, int o) {
+    const D zero_ = zero();
+    for (int k = 0; k < 3; ++k) st(b.patch_mass[k] + o, zero_);
+    st(b.twist_mass + o, zero_);
+    st(b.lambda_twist + o, zero_);
+    for (int i = 0; i < kMaxPoints; ++i) st(b.arm[i] + o, zero_);
   }
 
   static void fill(ContactBatch& b, const ContactBatchInput& in, const ContactFillParams& p) {
@@ -813,6 +1036,7 @@ struct Kernel {
       const D lin_n = dot(n, cmul(m_ab, n));
 
       V3 ran[kMaxPoints], rbn[kMaxPoints], ia_ran[kMaxPoints], ib_rbn[kMaxPoints];
+      V3 ras[kMaxPoints], rbs[kMaxPoints], fis[kMaxPoints];  // patch friction's inputs
       M valid[kMaxPoints];
       for (int i = 0; i < kMaxPoints; ++i) {
         ContactBatch::Point& q = b.p[i];
@@ -852,23 +1076,22 @@ struct Kernel {
         // sliding, so the pyramid's corners do not favour axes; else along
         // the carried friction impulse, else any perpendicular
         // (anyPerpendicular in cairn/math.hpp: n x (x or y), normalised).
-        const V3 vrel = sub(add(vb, cross(wb, rb)), add(va, cross(wa, ra)));
-        const V3 vt = sub(vrel, mul(n, dot(n, vrel)));
         const V3 fi = ld3(ip.friction_impulse, o);
-        const V3 carried = sub(fi, mul(n, dot(n, fi)));
-        const D vt2 = dot(vt, vt), carried2 = dot(carried, carried);
-        const M use_x = vabs(n.x) < 0.57735;
-        const V3 axis{sel(use_x, one, zero_), sel(use_x, zero_, one), zero_};
-        const V3 perp = cross(n, axis);
-        const D perp2 = dot(perp, perp);
-        const D rp = vsqrt(sel(perp2 > 0, perp2, one));
-        V3 t1 = sel3(perp2 > 0, V3{perp.x / rp, perp.y / rp, perp.z / rp}, perp);
-        const M carried_ok = carried2 > 1e-24;
-        const D rc = vsqrt(sel(carried_ok, carried2, one));
-        t1 = sel3(carried_ok, V3{carried.x / rc, carried.y / rc, carried.z / rc}, t1);
-        const M sliding = vt2 > 1e-6;
-        const D rv = vsqrt(sel(sliding, vt2, one));
-        t1 = sel3(sliding, V3{vt.x / rv, vt.y / rv, vt.z / rv}, t1);
+        if (p.patch) {  // no rows here: the patch's are made below
+          ras[i] = ra;
+          rbs[i] = rb;
+          fis[i] = sel3(ok, fi, zero3());
+          st3(q.t, o, zero3());
+          st3(q.ra, o, zero3());
+          st3(q.rb, o, zero3());
+          for (int k2 = 0; k2 < 2; ++k2) {
+            st(q.tangent_mass[k2] + o, zero_);
+            st(q.lambda_t[k2] + o, zero_);
+          }
+          continue;
+        }
+        const V3 vrel = sub(add(vb, cross(wb, rb)), add(va, cross(wa, ra)));
+        const V3 t1 = tangent(n, vrel, fi);
         put3(q.t, t1);
         // A tangent row left out keeps a zero effective mass: no row (the
         // residual, the statistics and the exported rows skip it).
@@ -890,6 +1113,8 @@ struct Kernel {
           rowPut(q.lambda_t[k2], splat(p.warm) * dot(fi, t));
         }
       }
+      if (p.patch) fillPatch(b, o, p, valid, ras, rbs, fis, ia, ib, m_ab, n, mu, va, wa, vb, wb);
+      else clearPatch(b, o);
       // The normal block, padded to 4 x 4 with identity rows.
       for (int i = 0; i < kMaxPoints; ++i)
         for (int j = 0; j <= i; ++j) {

@@ -297,6 +297,7 @@ ContactSweepParams sweepParams(const GraphProblem& p, const GraphSolveOptions& o
   sp.dynamic_end = o.dynamic_end;
   sp.gather_change = gather;
   sp.friction_rows = o.friction_rows;
+  sp.patch = o.patch_friction;
   sp.island_active = p.island_active.data();
   return sp;
 }

@@ -137,6 +137,7 @@ struct GraphSolveOptions {
   bool randomize_order = false;
   int dynamic_end = 1;  // solver bodies [1, dynamic_end) may be written (0 is the world)
   int friction_rows = 2;  // tangent rows per contact point
+  bool patch_friction = false;  // friction per manifold patch (solver/contact_batch.hpp)
   const ContactKernels* kernels = nullptr;
   WorkerPool* pool = nullptr;  // null: this thread only
   // Where planned, consecutive passes of a sweep overlap (pass_pipeline.hpp):

@@ -65,6 +65,10 @@ std::optional<ExactLcpProbe::Distance> ExactLcpProbe::afterStep(const World& wor
     why_ = "the step solved no rows";
     return std::nullopt;
   }
+  if (world.settings().patch_friction) {
+    why_ = "friction per patch: its disc and twist bounds are not the exact solver's friction model";
+    return std::nullopt;
+  }
   if (world.settings().sleeping && world.lastStepStats().sleeping_bodies > 0) {
     why_ = "bodies fell asleep (their velocities were zeroed after the solve)";
     return std::nullopt;

@@ -31,6 +31,7 @@ constexpr Key kKeys[] = {
     {"sleeping", Type::Bool},     {"geometric_stiffness", Type::Bool}, {"position_iterations", Type::Int},
     {"recycle_distance", Type::Real}, {"recycle_angle", Type::Real}, {"friction_directions", Type::Int},
     {"position_correction", Type::Correction}, {"prepare_contacts_each_substep", Type::Bool},
+    {"patch_friction", Type::Bool},
 };
 
 const Key* findKey(const std::string& name) {
@@ -131,6 +132,7 @@ void setSolverKey(SceneDesc& scene, const std::string& key, const std::string& v
       else if (key == "sleeping") s.sleeping = v;
       else if (key == "geometric_stiffness") s.geometric_stiffness = v;
       else if (key == "prepare_contacts_each_substep") s.prepare_contacts_each_substep = v;
+      else if (key == "patch_friction") s.patch_friction = v;
       else s.split_impulse = v;
       break;
     }
@@ -182,6 +184,7 @@ std::string solverKeyValue(const SceneDesc& scene, const std::string& key) {
   if (key == "sleeping") return s.sleeping ? "true" : "false";
   if (key == "geometric_stiffness") return s.geometric_stiffness ? "true" : "false";
   if (key == "prepare_contacts_each_substep") return s.prepare_contacts_each_substep ? "true" : "false";
+  if (key == "patch_friction") return s.patch_friction ? "true" : "false";
   if (key == "position_iterations") return std::to_string(s.position_iterations);
   if (key == "recycle_distance") return exactNumberText(s.recycle_distance);
   if (key == "recycle_angle") return exactNumberText(s.recycle_angle);

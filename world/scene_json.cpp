@@ -513,6 +513,7 @@ SolverSettings parseSolver(const json& j) {
   }
   s.max_correction_velocity = r.number("max_correction_velocity", s.max_correction_velocity);
   s.friction_directions = r.intIn("friction_directions", s.friction_directions, 1);
+  s.patch_friction = r.boolean("patch_friction", s.patch_friction);
   s.contact_margin = r.number("contact_margin", s.contact_margin);
   s.recycle_distance = r.number("recycle_distance", s.recycle_distance);
   s.recycle_angle = r.number("recycle_angle", s.recycle_angle);

@@ -26,7 +26,7 @@
 namespace cairn::detail {
 
 inline constexpr char kSnapshotMagic[8] = {'C', 'A', 'I', 'R', 'N', 'S', 'N', 'P'};
-inline constexpr std::uint32_t kSnapshotVersion = 6;
+inline constexpr std::uint32_t kSnapshotVersion = 7;
 inline constexpr size_t kSnapshotHeaderSize = 24;
 
 // The whole file for `w`.

@@ -102,6 +102,7 @@ void io(Ar& ar, SolverSettings& s) {
   ar(s.split_impulse);
   ar(s.max_correction_velocity);
   ar(s.friction_directions);
+  ar(s.patch_friction);
   ar(s.contact_margin);
   ar(s.recycle_distance);
   ar(s.recycle_angle);

@@ -66,12 +66,14 @@ const char* badLaneField(const ContactBatch& b, int l) {
   for (int k = 0; k < 3; ++k) sum += b.n[k][l] + b.ma[k][l] + b.mb[k][l];
   for (int k = 0; k < 6; ++k) sum += b.ia[k][l] + b.ib[k][l];
   for (int k = 0; k < 10; ++k) sum += b.block[k][l] + b.factor[k][l];
+  for (int k = 0; k < 3; ++k) sum += b.patch_mass[k][l];
+  sum += b.twist_mass[l];
   Real point = 0;
   for (int i = 0; i < kMaxPoints; ++i) {
     const ContactBatch::Point& p = b.p[i];
     for (int k = 0; k < 3; ++k)
       point += p.ran[k][l] + p.rbn[k][l] + p.t[k][l] + p.ra[k][l] + p.rb[k][l];
-    point += p.rhs[l] + p.bias[l] + p.normal_mass[l] + p.tangent_mass[0][l] + p.tangent_mass[1][l];
+    point += p.rhs[l] + p.bias[l] + p.normal_mass[l] + p.tangent_mass[0][l] + p.tangent_mass[1][l] + b.arm[i][l];
   }
   if (!std::isfinite(point)) return "anchor, target or effective mass";
   if (!std::isfinite(sum)) return "mass data, normal or block";

@@ -498,6 +498,7 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   fp.in_rhs = correction == Correction::InRhs;
   fp.first_substep = first_substep;
   fp.friction_rows = s.friction_directions;
+  fp.patch = s.patch_friction;
   const ContactKernels& kernels = contactKernelsFor(s);
   ContactRowSettings crs;
   crs.h = h;
@@ -647,7 +648,8 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   }
 
   // Rows by kind (statistics): a manifold's valid points are a normal row
-  // each and, with friction, one or two tangent rows.
+  // each and, with friction, one or two tangent rows (a patch: two tangent
+  // rows at point 0 and the twist row, all friction).
   int* kinds = w.stats_.rows_by_kind;
   for (const ConstraintRow& r : g.rows) ++kinds[static_cast<int>(r.kind)];
   for (const ConstraintRow& r : ctx.rows) ++kinds[static_cast<int>(r.kind)];
@@ -659,6 +661,8 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
           if (b.mu[l] > 0)
             for (int k = 0; k < 2; ++k) kinds[static_cast<int>(RowKind::ContactFriction)] += b.p[i].tangent_mass[k][l] > 0;
         }
+  for (const ContactBatch& b : g.batches)
+    for (int l = 0; l < kBatchLanes; ++l) kinds[static_cast<int>(RowKind::ContactFriction)] += b.twist_mass[l] > 0;
   int total = 0;
   for (int k = 0; k < kRowKindCount; ++k) total += kinds[k];
   w.stats_.rows = total;

@@ -29,6 +29,7 @@ GraphSolveOptions graphOptions(WorldImpl& w, const StepContext& ctx) {
   o.tolerance = s.tolerance;
   o.sor = s.sor;
   o.friction_rows = s.friction_directions;
+  o.patch_friction = s.patch_friction;
   o.nncg = s.nncg;
   o.randomize_order = s.randomize_order;
   o.dynamic_end = ctx.dynamic_count + 1;
@@ -54,11 +55,13 @@ struct LaneRow {
   Vec3 u, ra_u, rb_u;
 };
 
-LaneRow laneRowParts(const ContactBatch& b, int l, int i, int row) {  // row 0: normal, 1, 2: tangents
+// row 0: normal, 1, 2: tangents, 3: a patch's twist (solver/contact_batch.hpp)
+LaneRow laneRowParts(const ContactBatch& b, int l, int i, int row) {
   const ContactBatch::Point& q = b.p[i];
   const auto v3 = [&](const double (*f)[kBatchLanes]) { return Vec3(f[0][l], f[1][l], f[2][l]); };
   const Vec3 n = v3(b.n);
   if (row == 0) return {n, v3(q.ran), v3(q.rbn)};
+  if (row == 3) return {Vec3::Zero(), n, n};
   const Vec3 t1 = v3(q.t);
   const Vec3 u = row == 1 ? t1 : Vec3(n.cross(t1));
   return {u, v3(q.ra).cross(u), v3(q.rb).cross(u)};  // as the kernels form them
@@ -66,8 +69,9 @@ LaneRow laneRowParts(const ContactBatch& b, int l, int i, int row) {  // row 0: 
 
 // The natural-map residual of the manifolds (solver/lcp_residual.hpp's
 // definition, with the velocities after the solve): per row
-// |lambda - clamp(lambda - w, lo, hi)|, w = J v - rhs + cfm lambda.
-Real manifoldResidual(const GraphProblem& g, std::span<const SolverBody> v) {
+// |lambda - clamp(lambda - w, lo, hi)|, w = J v - rhs + cfm lambda; for a
+// friction patch the pair's |l - proj_disc(l - w)| and the twist row's.
+Real manifoldResidual(const GraphProblem& g, std::span<const SolverBody> v, bool patch) {
   Real worst = 0;
   for (const ContactBatch& b : g.batches)
     for (int l = 0; l < kBatchLanes; ++l) {
@@ -83,6 +87,7 @@ Real manifoldResidual(const GraphProblem& g, std::span<const SolverBody> v) {
         const Real wn = jv(laneRowParts(b, l, i, 0)) - q.rhs[l] + cfm * ln;
         worst = std::max(worst, std::abs(ln - std::max(ln - wn, Real(0))));
         if (b.mu[l] <= 0) continue;
+        if (patch) continue;
         const Real bound = b.mu[l] * ln;
         for (int k = 0; k < 2; ++k) {
           if (q.tangent_mass[k][l] == 0) continue;  // no such row
@@ -91,6 +96,26 @@ Real manifoldResidual(const GraphProblem& g, std::span<const SolverBody> v) {
           worst = std::max(worst, std::abs(lt - std::clamp(lt - wt, -bound, bound)));
         }
       }
+      if (!patch || b.mu[l] <= 0 || b.p[0].tangent_mass[0][l] == 0) continue;
+      Real load = 0, twist_load = 0;
+      for (int i = 0; i < b.count[l]; ++i) {
+        load += b.p[i].lambda[l];
+        twist_load += b.p[i].lambda[l] * b.arm[i][l];
+      }
+      const Real cfm = b.cfm[l];
+      const ContactBatch::Point& q = b.p[0];
+      const Eigen::Vector2d lt(q.lambda_t[0][l], q.lambda_t[1][l]);
+      const Eigen::Vector2d wt(jv(laneRowParts(b, l, 0, 1)) + cfm * lt[0], jv(laneRowParts(b, l, 0, 2)) + cfm * lt[1]);
+      Eigen::Vector2d x = lt - wt;
+      const Real limit = b.mu[l] * load;
+      if (x.norm() > limit) x *= limit / x.norm();
+      worst = std::max(worst, (lt - x).cwiseAbs().maxCoeff());
+      if (b.twist_mass[l] == 0) continue;
+      const Vec3 n(b.n[0][l], b.n[1][l], b.n[2][l]);
+      const Real tw = b.lambda_twist[l];
+      const Real wtw = n.dot(c.w - a.w) + cfm * tw;
+      const Real tlimit = b.mu[l] * twist_load;
+      worst = std::max(worst, std::abs(tw - std::clamp(tw - wtw, -tlimit, tlimit)));
     }
   return worst;
 }
@@ -125,7 +150,7 @@ void solveConstraints(WorldImpl& w, StepContext& ctx) {
     const GraphSolveStats st = solveGraph(ctx.graph, v, o, w.rng_state_, ctx.pseudo);
     w.stats_.iterations += st.iterations;
     if (s.compute_residual) {
-      residual = std::max(residual, manifoldResidual(ctx.graph, v));
+      residual = std::max(residual, manifoldResidual(ctx.graph, v, s.patch_friction));
       for (const RowGroup& grp : ctx.graph.groups)
         residual = std::max(residual,
                             lcpResidual(std::span<const ConstraintRow>(ctx.graph.rows).subspan(
@@ -197,6 +222,37 @@ bool stoppedIsland(const StepContext& ctx, std::int32_t isl) {
   return isl < 0 || (ctx.any_frozen && ctx.frozen_island[static_cast<size_t>(isl)]);
 }
 
+// Patch friction (solver/contact_batch.hpp): the patch's tangent impulse P
+// and twist impulse T shared out over its points as friction impulses with
+// the same sum and the same moment about the normal at the centre c,
+//   f_i = P / k + T (n x d_i) / sum_j |d_j|^2,   d_i = r_a,i - c in the plane,
+// over its k points with a normal row (sum_i n x d_i = 0, as c is their
+// mean). The contact reports them per point as with per-point friction,
+// and the fill reads P = sum f_i and T = sum n . (d_i x f_i) back. With
+// n x d_i = mean_j (r_a,j x n) - r_a,i x n the split needs only the
+// normal rows' angular parts.
+void splitPatch(Contact& c, const ContactBatch& b, int l) {
+  const ContactBatch::Point& q0 = b.p[0];
+  const Vec3 n = c.normal;
+  const Vec3 t1(q0.t[0][l], q0.t[1][l], q0.t[2][l]);
+  const Vec3 patch = t1 * q0.lambda_t[0][l] + n.cross(t1) * q0.lambda_t[1][l];
+  const auto ran = [&](int i) { return Vec3(b.p[i].ran[0][l], b.p[i].ran[1][l], b.p[i].ran[2][l]); };
+  int k = 0;
+  Vec3 mean = Vec3::Zero();
+  Real arm2 = 0;
+  for (int i = 0; i < c.count; ++i) {
+    if (b.p[i].valid[l] == 0) continue;
+    ++k;
+    mean += ran(i);
+    arm2 += b.arm[i][l] * b.arm[i][l];
+  }
+  if (k == 0) return;
+  mean /= Real(k);
+  const Real twist = arm2 > 0 ? b.lambda_twist[l] / arm2 : Real(0);
+  for (int i = 0; i < c.count; ++i)
+    c.points[i].friction_impulse = b.p[i].valid[l] == 0 ? Vec3::Zero() : Vec3(patch / Real(k) + (mean - ran(i)) * twist);
+}
+
 // One manifold lane's impulses back into its contact (nothing for padding
 // or a stopped island).
 void storeLane(WorldImpl& w, const StepContext& ctx, size_t slot) {
@@ -215,6 +271,7 @@ void storeLane(WorldImpl& w, const StepContext& ctx, size_t slot) {
     const Vec3 t1(q.t[0][l], q.t[1][l], q.t[2][l]);
     p.friction_impulse = t1 * q.lambda_t[0][l] + n.cross(t1) * q.lambda_t[1][l];
   }
+  if (w.settings_.patch_friction) splitPatch(c, b, l);
 }
 
 }  // namespace
@@ -387,6 +444,19 @@ std::vector<ConstraintRow> WorldImpl::expandedRows() const {
           r.owner_row = static_cast<std::int8_t>(4 + 2 * i + k);
           out.push_back(r);
         }
+        if (i > 0 || b.twist_mass[l] == 0) continue;
+        // A friction patch's twist row (its rows' bounds are the patch's,
+        // not mu times normal_row's impulse: the exact solvers do not take
+        // them, validation/lcp_probe.cpp).
+        ConstraintRow r = laneRow(b, l, 0, 3, b.twist_mass[l], RowKind::ContactFriction);
+        r.body_a = remap(b.body_a[l]);
+        r.body_b = remap(b.body_b[l]);
+        r.lambda = b.lambda_twist[l];
+        r.mu = b.mu[l];
+        r.normal_row = normal_at[point];
+        r.owner = ctx.lane_contact[bi * kBatchLanes + static_cast<size_t>(l)];
+        r.owner_row = 12;
+        out.push_back(r);
       }
     }
   }

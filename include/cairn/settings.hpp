@@ -113,6 +113,15 @@ struct SolverSettings {
   /// fewer contact rows, and nothing resists a start of sliding across it
   /// until the next step turns the tangent. docs/performance.md measures it.
   int friction_directions = 2;
+  /// Friction per manifold patch instead of per point, for islands solved
+  /// by PGS: two tangent rows at the centre of a manifold's points, bounded
+  /// together by the Coulomb cone of the manifold's total normal impulse,
+  /// and one twist row about the normal (ReactPhysics3D's and
+  /// bepuphysics2's contact friction): 4 + 3 rows for a four-point manifold
+  /// instead of 4 + 8 (friction_directions 2) or 4 + 4 (1), isotropic.
+  /// friction_directions is then not read; islands solved directly or
+  /// exactly keep per-point rows. docs/contacts.md measures it.
+  bool patch_friction = false;
 
   Real contact_margin = Real(0.02);  ///< m: contacts are made this far before touching (speculative)
   /// Contact recycling (Jolt's body pair cache): while a pair's relative

@@ -485,6 +485,24 @@ TEST(Determinism, ContactsOverSubstepsAreBitIdenticalOnAnyThreadsAndKernels) {
   }
 }
 
+// Friction per patch (SolverSettings::patch_friction): its 2 x 2 block, the
+// disc, the twist row and its NNCG momentum go through the same lanes, so
+// pyramid-20 gives one set of bits on any threads and kernels, at one
+// substep and at four (where its twist impulse is carried by the refresh).
+TEST(Determinism, PatchFrictionIsBitIdenticalOnAnyThreadsAndKernels) {
+  for (const int substeps : {1, 4}) {
+    SCOPED_TRACE(substeps);
+    SceneDesc s = scenarios::pyramid(20);
+    s.solver.patch_friction = true;
+    s.solver.substeps = substeps;
+    s.solver.iterations = substeps == 1 ? 10 : 3;
+    const auto one = run(s, 20, 1, Simd::Portable);
+    expectIdentical(one, run(s, 20, 2, Simd::Portable));
+    if (simdLevelAvailable(SimdLevel::Avx2)) expectIdentical(one, run(s, 20, 2, Simd::Avx2));
+    if (simdLevelAvailable(SimdLevel::Avx512)) expectIdentical(one, run(s, 20, 1, Simd::Avx512));
+  }
+}
+
 TEST(Determinism, PortableAndSimdKernelsGiveIdenticalTrajectories) {
   const SceneDesc s = scenarios::pyramid(10);
   const auto portable = run(s, kSteps, 1, Simd::Portable);

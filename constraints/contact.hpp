@@ -78,6 +78,15 @@ struct alignas(64) Contact {
   }
 };
 
+// Asks the cache for a contact's lines ahead of a walk that visits the
+// contacts in another order than they are stored (the solver's lane
+// order): a large scene's contacts leave the cache, and each visit would
+// otherwise wait for its lines one after another.
+inline void prefetchContact(const Contact& c) {
+  const char* p = reinterpret_cast<const char*>(&c);
+  for (size_t k = 0; k < sizeof(Contact); k += 64) __builtin_prefetch(p + k);
+}
+
 struct ContactRowSettings {
   Real h = Real(1) / 60;
   Real contact_erp = Real(0.2);

@@ -1030,6 +1030,10 @@ struct Kernel {
       st(b.mu + o, mu);
       st(b.cfm + o, sel(count > 0, cfm, zero_));  // a padding lane has no rows, and no CFM
       clearSweepState(b, o);
+      if (p.first_substep) {  // the correction pass's figures carry over the substeps
+        st(b.bias_delta + o, zero_);
+        st(b.bias_lambda + o, zero_);
+      }
       const V3 m_ab = add(ma, mb);
       const V3 xa = ld3(in.a.x, o), xb = ld3(in.b.x, o);
       const V3 va = ld3(in.a.v, o), wa = ld3(in.a.w, o), vb = ld3(in.b.v, o), wb = ld3(in.b.w, o);

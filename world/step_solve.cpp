@@ -280,7 +280,15 @@ void storeLaneImpulses(WorldImpl& w, StepContext& ctx) {
   // Each lane writes its own contact (on the pool's threads when there are
   // many).
   const auto storeLanes = [&](int begin, int end) {
-    for (int k = begin; k < end; ++k) storeLane(w, ctx, static_cast<size_t>(k));
+    for (int k = begin; k < end; ++k) {
+      // The contact a batch ahead, while this one is written.
+      const int ahead = k + kBatchLanes;
+      if (ahead < end) {
+        const std::int32_t ci = ctx.lane_contact[static_cast<size_t>(ahead)];
+        if (ci >= 0) prefetchContact(w.contacts_[static_cast<size_t>(ci)]);
+      }
+      storeLane(w, ctx, static_cast<size_t>(k));
+    }
   };
   const int slots = static_cast<int>(ctx.lane_contact.size());
   if (w.pool_ && slots >= kParallelLanes) w.pool_->parallelFor(slots, storeLanes);

@@ -192,15 +192,27 @@ bool WorldImpl::shouldCollide(const Body& a, const Body& b, BodyId ia, BodyId ib
 }
 
 Real WorldImpl::contactDepth(const Contact& c) const {
-  // The world body sits at the origin, unrotated: its local points are world points.
-  const auto point = [&](BodyId id, const Vec3& local) -> Vec3 {
-    if (id.isWorld()) return local;
+  // Per point -n . (p_b - p_a), p = x + R l: with the normal taken into
+  // each body's frame once, -(n . (x_b - x_a) + (R_b^T n) . l_b - (R_a^T n) . l_a),
+  // two rotations a manifold instead of two a point. The world body sits at
+  // the origin, unrotated.
+  const auto side = [&](BodyId id, Vec3& x, Vec3& n_local) {
+    if (id.isWorld()) {
+      x.setZero();
+      n_local = c.normal;
+      return;
+    }
     const Body& b = bodies_[static_cast<size_t>(id.index)];
-    return b.position + b.orientation * local;
+    x = b.position;
+    n_local = b.orientation.conjugate() * c.normal;
   };
+  Vec3 xa, xb, na, nb;
+  side(c.body_a, xa, na);
+  side(c.body_b, xb, nb);
+  const Real centres = c.normal.dot(xb - xa);
   Real depth = 0;
   for (int i = 0; i < c.count; ++i)
-    depth = std::max(depth, -(point(c.body_b, c.points[i].local_b) - point(c.body_a, c.points[i].local_a)).dot(c.normal));
+    depth = std::max(depth, -(centres + nb.dot(c.points[i].local_b) - na.dot(c.points[i].local_a)));
   return depth;
 }
 
@@ -232,8 +244,8 @@ bool pairsAtRest(const WorldImpl& w) {
 // recycled manifold, else the narrowphase's. Reads the world only (the
 // pool's threads run it side by side); `manifolds` is scratch. Returns
 // whether a manifold was recycled.
-bool collidePair(const WorldImpl& w, int pa, int pb, Real h, Real cos_half_angle, std::vector<Manifold>& manifolds,
-                 std::vector<Contact>& out) {
+bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys, int pa, int pb, Real h,
+                 Real cos_half_angle, std::vector<Manifold>& manifolds, std::vector<Contact>& out) {
   const std::vector<Contact>& old = w.old_contacts_;
   std::int32_t sa = w.broadphase_.user(pa), sb = w.broadphase_.user(pb);
   if (sa > sb) std::swap(sa, sb);
@@ -243,10 +255,9 @@ bool collidePair(const WorldImpl& w, int pa, int pb, Real h, Real cos_half_angle
   const Body& bb = w.body(rb.body);
   if (!w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
   // Last step's contacts of this pair. They are sorted by key, whose high
-  // bits are the two shapes: a binary search (for the key alone, not a
-  // default 700-byte Contact made per pair).
-  const auto cached = std::lower_bound(old.begin(), old.end(), Contact::keyOf(sa, sb, -1),
-                                       [](const Contact& x, std::uint64_t k) { return x.key() < k; });
+  // bits are the two shapes: a binary search over their keys.
+  const auto cached = old.begin() + (std::lower_bound(old_keys.begin(), old_keys.end(), Contact::keyOf(sa, sb, -1)) -
+                                     old_keys.begin());
   if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were
     for (auto it = cached; it != old.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
       out.push_back(*it);
@@ -301,6 +312,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
   BroadPhase& broadphase_ = w.broadphase_;
   std::vector<Contact>& contacts_ = w.contacts_;
   std::vector<Contact>& old_contacts_ = w.old_contacts_;
+  std::vector<std::uint64_t>& old_keys = ctx.old_keys;
   const auto body = [&](BodyId id) -> const Body& { return w.body(id); };
   // 1. Broadphase: move the proxies of bodies that can move.
   w.moveProxies(kWorldBody, h);
@@ -321,6 +333,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
   const bool at_rest = !pairs_changed && pairsAtRest(w);
   if (at_rest) {
     old_contacts_.clear();
+    old_keys.clear();
     for (Contact& c : contacts_) {  // and warm started as below, in the same walk
       c.carried = true;
       c.began = !c.touching;
@@ -332,12 +345,14 @@ void collide(WorldImpl& w, StepContext& ctx) {
     const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
     if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key))
       std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
+    old_keys.resize(old_contacts_.size());
+    for (size_t i = 0; i < old_contacts_.size(); ++i) old_keys[i] = old_contacts_[i].key();
     const Real cos_half_angle = std::cos(settings_.recycle_angle / 2);
     const auto pairRange = [&](int begin, int end, std::vector<Contact>& out, std::vector<Manifold>& manifolds) {
       int recycled = 0;
       for (int k = begin; k < end; ++k) {
         const auto& [pa, pb] = w.pairs_[static_cast<size_t>(k)];
-        recycled += collidePair(w, pa, pb, h, cos_half_angle, manifolds, out);
+        recycled += collidePair(w, old_keys, pa, pb, h, cos_half_angle, manifolds, out);
       }
       return recycled;
     };
@@ -378,8 +393,8 @@ void collide(WorldImpl& w, StepContext& ctx) {
       c.began = !c.touching;
       return;
     }
-    const auto it = std::lower_bound(old_contacts_.begin(), old_contacts_.end(), c.key(),
-                                     [](const Contact& x, std::uint64_t k) { return x.key() < k; });
+    const auto it = old_contacts_.begin() +
+                    (std::lower_bound(old_keys.begin(), old_keys.end(), c.key()) - old_keys.begin());
     if (it == old_contacts_.end() || it->key() != c.key()) {
       c.began = true;
       return;

@@ -189,6 +189,10 @@ struct StepContext {
   std::vector<char> sunk_below;
   // Body pairs a joint keeps from colliding, sorted (collide, shouldCollide).
   std::vector<std::uint64_t> jointed_pairs;
+  // Last step's contacts' keys, in their (sorted) order: the pairs' and the
+  // warm start's binary searches run over these 8 bytes a contact instead
+  // of touching a 704-byte contact at every probe.
+  std::vector<std::uint64_t> old_keys;
 };
 
 class WorldImpl {

@@ -38,6 +38,8 @@ namespace cairn {
 inline constexpr int kBatchLanes = 8;
 inline constexpr int kMaxPoints = 4;
 
+// Every field is written by the fill kernel before a sweep reads it: the
+// batches are not zeroed when their array is resized (huge_page_allocator.hpp).
 struct alignas(64) ContactBatch {
   using Lanes = double[kBatchLanes];
   std::int32_t body_a[kBatchLanes];  // solver body indices

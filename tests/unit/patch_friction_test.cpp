@@ -25,9 +25,10 @@ struct Box {
 
 // A unit box (1 kg) resting on a static ground slab tilted by `slope`
 // radians about z, both mu = 0.5, given velocities v0 and w0.
-Box boxOnGround(Real slope, const Vec3& v0, const Vec3& w0, bool patch = true) {
+Box boxOnGround(Real slope, const Vec3& v0, const Vec3& w0, bool patch = true, int directions = 2) {
   WorldDef def;
   def.settings.patch_friction = patch;
+  def.settings.friction_directions = directions;
   def.settings.sleeping = false;
   def.settings.recycle_distance = 0;  // the narrowphase every step: reported points at the step's pose
   Box out{World(def), BodyId{}};
@@ -100,16 +101,9 @@ TEST(PatchFriction, HoldsBelowTheFrictionAngleAndSlidesAbove) {
 // against four with one direction per point and eight with two.
 TEST(PatchFriction, AFourPointManifoldMakesThreeFrictionRows) {
   const auto frictionRows = [](bool patch, int directions) {
-    WorldDef def;
-    def.settings.patch_friction = patch;
-    def.settings.friction_directions = directions;
-    World w(def);
-    BodyDef g = test::boxDef("ground", Vec3(0, -0.5, 0), 1, Vec3(20, 0.5, 20));
-    g.type = BodyType::Static;
-    w.createBody(g);
-    w.createBody(test::boxDef("box", Vec3(0, 0.5, 0)));
-    w.step(kDt);
-    return w.lastStepStats().rows_by_kind[static_cast<int>(RowKind::ContactFriction)];
+    Box s = boxOnGround(0, Vec3::Zero(), Vec3::Zero(), patch, directions);
+    s.world.step(kDt);
+    return s.world.lastStepStats().rows_by_kind[static_cast<int>(RowKind::ContactFriction)];
   };
   EXPECT_EQ(frictionRows(true, 2), 3);
   EXPECT_EQ(frictionRows(true, 1), 3);  // friction_directions is not read

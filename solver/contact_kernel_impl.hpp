@@ -313,6 +313,15 @@ struct Kernel {
     l0 = l0 * scale;
     l1 = l1 * scale;
   }
+  // A patch's tangent pair, in point 0's tangent fields: t1, t2 = n x t1
+  // and their angular parts at the centre's anchors.
+  struct PairRows {
+    V3 t1, t2, ra1, rb1, ra2, rb2;
+  };
+  CAIRN_INLINE PairRows pairRows(const ContactBatch::Point& q, int o, const V3& n) {
+    const V3 t1 = ld3(q.t, o), t2 = cross(n, t1), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
+    return {t1, t2, cross(ra, t1), cross(rb, t1), cross(ra, t2), cross(rb, t2)};
+  }
   // The patch's bounds from its points' normal impulses: mu sum lambda_i
   // for the tangent pair, mu sum lambda_i d_i for the twist.
   CAIRN_INLINE void patchLimits(const ContactBatch& b, int o, int points, D mu, const D* lam, D& limit, D& twist_limit) {
@@ -513,10 +522,9 @@ struct Kernel {
     D limit, twist_limit;
     patchLimits(b, o, points, mu, lam, limit, twist_limit);
     ContactBatch::Point& q = b.p[0];
-    const V3 t1 = ld3(q.t, o), t2 = cross(n, t1), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
-    const V3 ra1 = cross(ra, t1), rb1 = cross(rb, t1), ra2 = cross(ra, t2), rb2 = cross(rb, t2);
+    const PairRows r = pairRows(q, o, n);
     const D l0 = ld(q.lambda_t[0] + o), l1 = ld(q.lambda_t[1] + o);
-    const D v0 = rowVel(s, t1, ra1, rb1) + cfm * l0, v1 = rowVel(s, t2, ra2, rb2) + cfm * l1;
+    const D v0 = rowVel(s, r.t1, r.ra1, r.rb1) + cfm * l0, v1 = rowVel(s, r.t2, r.ra2, r.rb2) + cfm * l1;
     const D k00 = ld(b.patch_mass[0] + o), k01 = ld(b.patch_mass[1] + o), k11 = ld(b.patch_mass[2] + o);
     D n0 = l0 - sor * (k00 * v0 + k01 * v1), n1 = l1 - sor * (k01 * v0 + k11 * v1);
     clampDisc(n0, n1, limit);
@@ -524,8 +532,8 @@ struct Kernel {
     n1 = sel(active, n1, l1);
     const D d0 = n0 - l0, d1 = n1 - l1;
     Sum sum{zero3(), zero3(), zero3()};
-    addRow(sum, t1, ra1, rb1, d0);
-    addRow(sum, t2, ra2, rb2, d1);
+    addRow(sum, r.t1, r.ra1, r.rb1, d0);
+    addRow(sum, r.t2, r.ra2, r.rb2, d1);
     applySum(s, m, sum);
     st(q.lambda_t[0] + o, n0);
     st(q.lambda_t[1] + o, n1);
@@ -638,9 +646,9 @@ struct Kernel {
     st(q.lambda_t[1] + o, n1);
     st(q.dir_t[0] + o, newDir(p0, ld(q.change_t[0] + o)));
     st(q.dir_t[1] + o, newDir(p1, ld(q.change_t[1] + o)));
-    const V3 t1 = ld3(q.t, o), t2 = cross(n, t1), ra = ld3(q.ra, o), rb = ld3(q.rb, o);
-    addRow(sum, t1, cross(ra, t1), cross(rb, t1), n0 - l0);
-    addRow(sum, t2, cross(ra, t2), cross(rb, t2), n1 - l1);
+    const PairRows r = pairRows(q, o, n);
+    addRow(sum, r.t1, r.ra1, r.rb1, n0 - l0);
+    addRow(sum, r.t2, r.ra2, r.rb2, n1 - l1);
     const D lt = ld(b.lambda_twist + o), pt = ld(b.dir_twist + o);
     const D nt = sel(apply, vmin(vmax(lt + bstep * pt, -twist_limit), twist_limit), lt);
     st(b.lambda_twist + o, nt);

@@ -659,15 +659,15 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
   for (const ConstraintRow& r : g.rows) ++kinds[static_cast<int>(r.kind)];
   for (const ConstraintRow& r : ctx.rows) ++kinds[static_cast<int>(r.kind)];
   for (const ContactBatch& b : g.batches)
-    for (int l = 0; l < kBatchLanes; ++l)
+    for (int l = 0; l < kBatchLanes; ++l) {
+      kinds[static_cast<int>(RowKind::ContactFriction)] += b.twist_mass[l] > 0;
       for (int i = 0; i < b.count[l]; ++i)
         if (b.p[i].valid[l] > 0) {
           ++kinds[static_cast<int>(RowKind::ContactNormal)];
           if (b.mu[l] > 0)
             for (int k = 0; k < 2; ++k) kinds[static_cast<int>(RowKind::ContactFriction)] += b.p[i].tangent_mass[k][l] > 0;
         }
-  for (const ContactBatch& b : g.batches)
-    for (int l = 0; l < kBatchLanes; ++l) kinds[static_cast<int>(RowKind::ContactFriction)] += b.twist_mass[l] > 0;
+    }
   int total = 0;
   for (int k = 0; k < kRowKindCount; ++k) total += kinds[k];
   w.stats_.rows = total;

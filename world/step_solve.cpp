@@ -231,11 +231,7 @@ bool stoppedIsland(const StepContext& ctx, std::int32_t isl) {
 // and the fill reads P = sum f_i and T = sum n . (d_i x f_i) back. With
 // n x d_i = mean_j (r_a,j x n) - r_a,i x n the split needs only the
 // normal rows' angular parts.
-void splitPatch(Contact& c, const ContactBatch& b, int l) {
-  const ContactBatch::Point& q0 = b.p[0];
-  const Vec3 n = c.normal;
-  const Vec3 t1(q0.t[0][l], q0.t[1][l], q0.t[2][l]);
-  const Vec3 patch = t1 * q0.lambda_t[0][l] + n.cross(t1) * q0.lambda_t[1][l];
+void splitPatch(Contact& c, const ContactBatch& b, int l, const Vec3& patch) {  // patch: P
   const auto ran = [&](int i) { return Vec3(b.p[i].ran[0][l], b.p[i].ran[1][l], b.p[i].ran[2][l]); };
   int k = 0;
   Vec3 mean = Vec3::Zero();
@@ -246,7 +242,10 @@ void splitPatch(Contact& c, const ContactBatch& b, int l) {
     mean += ran(i);
     arm2 += b.arm[i][l] * b.arm[i][l];
   }
-  if (k == 0) return;
+  if (k == 0) {  // no normal row: no friction either
+    for (int i = 0; i < c.count; ++i) c.points[i].friction_impulse.setZero();
+    return;
+  }
   mean /= Real(k);
   const Real twist = arm2 > 0 ? b.lambda_twist[l] / arm2 : Real(0);
   for (int i = 0; i < c.count; ++i)
@@ -262,16 +261,21 @@ void storeLane(WorldImpl& w, const StepContext& ctx, size_t slot) {
   const int l = static_cast<int>(slot % kBatchLanes);
   if (stoppedIsland(ctx, b.island[l])) return;
   Contact& c = w.contacts_[static_cast<size_t>(ci)];
-  const Vec3 n = c.normal;
+  // A point's tangent pair (t1, n x t1) as one world vector; with patch
+  // friction point 0's pair is the patch's.
+  const auto tangentImpulse = [&](const ContactBatch::Point& q) {
+    const Vec3 t1(q.t[0][l], q.t[1][l], q.t[2][l]);
+    return Vec3(t1 * q.lambda_t[0][l] + c.normal.cross(t1) * q.lambda_t[1][l]);
+  };
+  const bool patch = w.settings_.patch_friction;
   for (int i = 0; i < c.count; ++i) {
     const ContactBatch::Point& q = b.p[i];
     ContactPointState& p = c.points[i];
     p.normal_impulse = q.lambda[l];
     p.max_impulse = std::max(p.max_impulse, q.max_lambda[l]);
-    const Vec3 t1(q.t[0][l], q.t[1][l], q.t[2][l]);
-    p.friction_impulse = t1 * q.lambda_t[0][l] + n.cross(t1) * q.lambda_t[1][l];
+    if (!patch) p.friction_impulse = tangentImpulse(q);
   }
-  if (w.settings_.patch_friction) splitPatch(c, b, l);
+  if (patch) splitPatch(c, b, l, tangentImpulse(b.p[0]));
 }
 
 }  // namespace

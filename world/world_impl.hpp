@@ -26,6 +26,7 @@
 #include "solver/pgs.hpp"
 #include "solver/solver_body.hpp"
 #include "solver/worker_pool.hpp"
+#include "world/pool_watch.hpp"
 
 #include <memory>
 #include <optional>
@@ -356,14 +357,12 @@ class WorldImpl {
   DirectSolver position_solver_;  // the joint position pass's own (its rows' pattern differs)
   std::unique_ptr<WorkerPool> pool_;  // the step's threads; null: the calling thread alone
   // The pool set aside while its threads were found sharing their cores
-  // with other work (world_step.cpp, watchPool): for solo_steps_ more
-  // steps, then taken back; solo_length_ steps the next time.
+  // with other work (world/pool_watch.hpp: for how many steps).
   std::unique_ptr<WorkerPool> parked_pool_;
-  int solo_steps_ = 0;
-  int solo_length_ = 0;
+  PoolWatch pool_watch_;
   // false: the pool is never set aside (the tests that must run every step
   // on their threads, whatever else the machine runs).
-  bool pool_watch_ = true;
+  bool watch_pool_ = true;
   std::uint64_t rng_state_ = 0;
   bool rng_seeded_ = false;
 

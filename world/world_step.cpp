@@ -72,52 +72,31 @@ void clearForces(WorldImpl& w, const StepContext& ctx) {
   w.forced_bodies_.clear();
 }
 
-// A pool whose threads lose their cores to other work in a step
-// (WorkerPool::takePreemptedWaits) runs the step slower than one thread:
-// its loops hand work between threads every few microseconds, and each
-// handover waits for a thread that is not running. So after a step with
-// kPreemptedPerStep such waits the pool is set aside and the world steps
-// on the calling thread alone for kSoloFirst steps, twice as many each
-// time the pool is found sharing its cores again (up to kSoloMost), then
-// takes it back to try. Results do not depend on the thread count
-// (tests/unit/solver_determinism_test.cpp), so neither do they on this.
-constexpr int kPreemptedPerStep = 8;
-constexpr int kSoloFirst = 16;
-constexpr int kSoloMost = 1024;
-
 // The worker pool follows SolverSettings::threads, less the steps it sits
-// out (watchPool).
+// out after its threads were found sharing their cores (world/pool_watch.hpp).
 void fitPool(WorldImpl& w) {
   const int threads = w.settings_.threads;
   if (threads <= 1) {
     w.pool_.reset();
     w.parked_pool_.reset();
-    w.solo_steps_ = 0;
+    w.pool_watch_.reset();
     return;
   }
   if (w.parked_pool_) {
-    if (w.solo_steps_ > 0) {
-      --w.solo_steps_;
-      return;
-    }
+    if (!w.pool_watch_.startStep()) return;
     w.pool_ = std::move(w.parked_pool_);
   }
   if (!w.pool_ || w.pool_->threads() != threads) {
     w.pool_ = std::make_unique<WorkerPool>(threads);
-    w.solo_length_ = kSoloFirst;
+    w.pool_watch_.reset();
   }
 }
 
 // After the step: sets the pool aside when its threads lost their cores.
 void watchPool(WorldImpl& w) {
   if (!w.pool_) return;
-  if (w.pool_->takePreemptedWaits() < kPreemptedPerStep || !w.pool_watch_) {
-    w.solo_length_ = kSoloFirst;
-    return;
-  }
-  w.parked_pool_ = std::move(w.pool_);
-  w.solo_steps_ = w.solo_length_;
-  w.solo_length_ = std::min(2 * w.solo_length_, kSoloMost);
+  const std::int64_t preempted = w.pool_->takePreemptedWaits();
+  if (w.pool_watch_.endPoolStep(w.watch_pool_ ? preempted : 0)) w.parked_pool_ = std::move(w.pool_);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 #include <thread>
 #include <type_traits>
@@ -42,7 +43,16 @@ class WorkerPool {
   // handover: on a 2-core machine with two other busy processes, an
   // awake pyramid-20 stepped 24 times slower on two threads than on one.
   // Returns the count since the last call and starts it again.
-  std::int64_t takePreemptedWaits() { return preempted_.exchange(0, std::memory_order_relaxed); }
+  // While lost cores are simulated (simulateLostCores, for tests), every
+  // call answers as if all of the pool's waits had lost their cores.
+  std::int64_t takePreemptedWaits() {
+    const std::int64_t n = preempted_.exchange(0, std::memory_order_relaxed);
+    return simulated_lost_cores_.load(std::memory_order_relaxed) ? std::numeric_limits<std::int64_t>::max() : n;
+  }
+  // For tests of what follows a lost core (a World stepping alone, the
+  // bench's note of it) without depending on which steps the machine's
+  // scheduler takes the core from: process-wide, while `on`.
+  static void simulateLostCores(bool on) { simulated_lost_cores_.store(on, std::memory_order_relaxed); }
   // 0 on the thread that calls parallelFor, 1 .. threads - 1 on the workers.
   static int currentThread();
 
@@ -98,6 +108,7 @@ class WorkerPool {
   std::atomic<int> remaining_{0};
   std::atomic<bool> stop_{false};
   std::atomic<std::int64_t> preempted_{0};
+  static inline std::atomic<bool> simulated_lost_cores_{false};
 };
 
 }  // namespace cairn

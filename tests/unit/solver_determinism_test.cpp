@@ -99,6 +99,30 @@ TEST(Determinism, AWorldWhoseThreadsShareOneCoreStepsAloneWithTheSameBits) {
   expectIdentical(run(s, kSharedSteps, 1, Simd::Auto), shared);
 }
 
+// The same with the lost cores simulated (WorkerPool::simulateLostCores:
+// every step on the pool is found sharing), so the World follows the rule
+// on every step whatever the scheduler does: steps 1, 18 and 51 on the
+// pool (runs alone of 16 and 32), the rest alone, and one thread's bits.
+TEST(Determinism, AWorldWhoseCoresAreLostStepsAloneByTheRuleWithTheSameBits) {
+  const SceneDesc s = scenarios::pyramid(20);
+  constexpr int kSteps = 60;
+  SceneDesc two = s;
+  two.solver.threads = 2;
+  World w = buildWorld(two);
+  std::vector<int> on_pool;
+  WorkerPool::simulateLostCores(true);
+  for (int k = 0; k < kSteps; ++k) {
+    w.step(s.dt);
+    if (w.lastStepStats().threads == 2) on_pool.push_back(k + 1);
+  }
+  WorkerPool::simulateLostCores(false);
+  EXPECT_EQ(on_pool, (std::vector<int>{1, 18, 51}));
+  std::vector<Pose> shared;
+  for (const Body& b : detail::internals(w).bodies())
+    shared.push_back({b.position, b.linear_velocity, b.angular_velocity, b.orientation});
+  expectIdentical(run(s, kSteps, 1, Simd::Auto), shared);
+}
+
 // 40 steps: the pyramid settles through its first contacts, the chain
 // takes up its tension, the ragdoll falls (2 threads on these 2-core CI
 // machines, 4 oversubscribed: the answer may not depend on either).

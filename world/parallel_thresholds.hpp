@@ -6,7 +6,7 @@
 // (solver/graph_solver.cpp). Results never depend on them: the threads
 // split a loop's items and every reduction runs in storage order on one
 // thread (tests/unit/solver_determinism_test.cpp runs scenes past all
-// six on 1, 2 and 4 threads).
+// five on 1, 2 and 4 threads).
 #pragma once
 
 namespace cairn::detail {
@@ -21,11 +21,6 @@ namespace cairn::detail {
 // threads against 0.038 on one, while the 5,050-box pyramid (15,000
 // pairs) went from 13.9 to 9.2 ms.
 constexpr int kParallelPairs = 1024;
-
-// Moved proxies below which the broadphase's pair queries (one tree
-// descent each, about a microsecond on a 5,000-box tree) stay on the
-// calling thread (world/world_contacts.cpp).
-constexpr int kParallelMovedProxies = 256;
 
 // Batches below which the lanes are gathered, filled and factored on the
 // calling thread (world/step_prepare.cpp). With the fill kernel a batch

@@ -601,10 +601,8 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
     ContactBatchInput in;
     for (int bi = begin; bi < end; ++bi) {
       if (bi + 1 < end)  // the next batch's contacts, while this one is gathered (step_solve.cpp's store does the same)
-        for (int lane = 0; lane < kBatchLanes; ++lane) {
-          const std::int32_t ci = ctx.lane_contact[static_cast<size_t>(bi + 1) * kBatchLanes + static_cast<size_t>(lane)];
-          if (ci >= 0) prefetchContact(w.contacts_[static_cast<size_t>(ci)]);
-        }
+        for (int lane = 0; lane < kBatchLanes; ++lane)
+          prefetchLaneContact(w, ctx, static_cast<size_t>(bi + 1) * kBatchLanes + static_cast<size_t>(lane));
       ContactBatch& batch = g.batches[static_cast<size_t>(bi)];
       if (refresh_lanes && !(last_substep && anyBounce(batch))) refreshBatch(in, batch, bi);
       else fillBatch(in, batch, bi);

@@ -286,11 +286,7 @@ void storeLaneImpulses(WorldImpl& w, StepContext& ctx) {
   const auto storeLanes = [&](int begin, int end) {
     for (int k = begin; k < end; ++k) {
       // The contact a batch ahead, while this one is written.
-      const int ahead = k + kBatchLanes;
-      if (ahead < end) {
-        const std::int32_t ci = ctx.lane_contact[static_cast<size_t>(ahead)];
-        if (ci >= 0) prefetchContact(w.contacts_[static_cast<size_t>(ci)]);
-      }
+      if (k + kBatchLanes < end) prefetchLaneContact(w, ctx, static_cast<size_t>(k + kBatchLanes));
       storeLane(w, ctx, static_cast<size_t>(k));
     }
   };

@@ -40,6 +40,13 @@ void storeImpulses(WorldImpl& w, StepContext& ctx);
 // The contact lanes' impulses into the contact cache (the islands a guard
 // stopped keep theirs); clears StepContext::lanes_unstored.
 void storeLaneImpulses(WorldImpl& w, StepContext& ctx);
+// Asks the cache for the contact in lane slot `slot` (none for an empty
+// lane), ahead of the fill's or the store's visit to it: the lanes visit
+// the contacts out of their storage order.
+inline void prefetchLaneContact(const WorldImpl& w, const StepContext& ctx, size_t slot) {
+  const std::int32_t ci = ctx.lane_contact[slot];
+  if (ci >= 0) prefetchContact(w.contacts_[static_cast<size_t>(ci)]);
+}
 // Restitution, once per step after the last substep (world/step_solve.cpp).
 void applyRestitution(WorldImpl& w, StepContext& ctx);
 // Contact begin/end events (world/world_contacts.cpp).

@@ -239,6 +239,14 @@ bool pairsAtRest(const WorldImpl& w) {
   return true;
 }
 
+// The first of last step's contacts whose key is not below `key` (they
+// are sorted by key): a binary search over their keys alone, not the
+// 704-byte contacts.
+std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>& old,
+                                                     const std::vector<std::uint64_t>& old_keys, std::uint64_t key) {
+  return old.begin() + (std::lower_bound(old_keys.begin(), old_keys.end(), key) - old_keys.begin());
+}
+
 // One candidate pair (broadphase handles pa, pb): its contacts appended to
 // `out`, last step's kept as they were when neither body moves, else a
 // recycled manifold, else the narrowphase's. Reads the world only (the
@@ -254,10 +262,9 @@ bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys,
   const Body& ba = w.body(ra.body);
   const Body& bb = w.body(rb.body);
   if (!w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
-  // Last step's contacts of this pair. They are sorted by key, whose high
-  // bits are the two shapes: a binary search over their keys.
-  const auto cached = old.begin() + (std::lower_bound(old_keys.begin(), old_keys.end(), Contact::keyOf(sa, sb, -1)) -
-                                     old_keys.begin());
+  // Last step's contacts of this pair: their keys' high bits are the two
+  // shapes.
+  const auto cached = firstOldContact(old, old_keys, Contact::keyOf(sa, sb, -1));
   if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were
     for (auto it = cached; it != old.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
       out.push_back(*it);
@@ -393,8 +400,7 @@ void collide(WorldImpl& w, StepContext& ctx) {
       c.began = !c.touching;
       return;
     }
-    const auto it = old_contacts_.begin() +
-                    (std::lower_bound(old_keys.begin(), old_keys.end(), c.key()) - old_keys.begin());
+    const auto it = firstOldContact(old_contacts_, old_keys, c.key());
     if (it == old_contacts_.end() || it->key() != c.key()) {
       c.began = true;
       return;

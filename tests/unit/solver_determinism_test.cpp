@@ -42,14 +42,18 @@ World threadedWorld(SceneDesc s, int threads) {
   return w;
 }
 
-std::vector<Pose> run(SceneDesc s, int steps, int threads, Simd simd) {
-  s.solver.simd = simd;
-  World w = threadedWorld(s, threads);
-  for (int k = 0; k < steps; ++k) w.step(s.dt);
+std::vector<Pose> posesOf(World& w) {
   std::vector<Pose> out;
   for (const Body& b : detail::internals(w).bodies())
     out.push_back({b.position, b.linear_velocity, b.angular_velocity, b.orientation});
   return out;
+}
+
+std::vector<Pose> run(SceneDesc s, int steps, int threads, Simd simd) {
+  s.solver.simd = simd;
+  World w = threadedWorld(s, threads);
+  for (int k = 0; k < steps; ++k) w.step(s.dt);
+  return posesOf(w);
 }
 
 void expectIdentical(const std::vector<Pose>& a, const std::vector<Pose>& b) {
@@ -85,8 +89,7 @@ TEST(Determinism, AWorldWhoseThreadsShareOneCoreStepsAloneWithTheSameBits) {
       w.step(s.dt);
       threads.push_back(w.lastStepStats().threads);
     }
-    for (const Body& b : detail::internals(w).bodies())
-      shared.push_back({b.position, b.linear_velocity, b.angular_velocity, b.orientation});
+    shared = posesOf(w);
   }
   // The rule replayed: a step on the pool followed by a step alone was
   // found sharing, one followed by another on the pool was not.
@@ -117,10 +120,7 @@ TEST(Determinism, AWorldWhoseCoresAreLostStepsAloneByTheRuleWithTheSameBits) {
   }
   WorkerPool::simulateLostCores(false);
   EXPECT_EQ(on_pool, (std::vector<int>{1, 18, 51}));
-  std::vector<Pose> shared;
-  for (const Body& b : detail::internals(w).bodies())
-    shared.push_back({b.position, b.linear_velocity, b.angular_velocity, b.orientation});
-  expectIdentical(run(s, kSteps, 1, Simd::Auto), shared);
+  expectIdentical(run(s, kSteps, 1, Simd::Auto), posesOf(w));
 }
 
 // 40 steps: the pyramid settles through its first contacts, the chain

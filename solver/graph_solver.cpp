@@ -423,9 +423,79 @@ IslandFigures fusedBiasFigures(GraphProblem& p) { return {p.bias_active, p.bias_
 // A lane figure of the batches: a pass's largest change or impulse.
 using LaneFigure = double (ContactBatch::*)[kBatchLanes];
 
-// Each island's largest change and impulse of the sweep, gathered in
-// storage order (the same whatever the threads did): the lanes' figures
-// `delta` and `lambda` (none when null), and the row groups' with `groups`.
+// x becomes the larger of x and d, and NaN once either is: a non-finite
+// island never looks converged, and the result does not depend on the
+// order the figures are folded in (so not on which thread folded which).
+void foldFigure(double& x, double d) {
+  if (x == x && !(x >= d)) x = d;
+}
+
+// The lane figures of batches [b0, b1) into the calling thread's row of
+// GraphProblem::lane_figures, after their friction visit: the sweep's
+// where the island's sweeps go on, and with `bias` the correction's where
+// its own go on.
+void foldLaneFigures(GraphProblem& p, int b0, int b1, bool bias) {
+  const int thread = p.lane_figure_threads > 1 ? WorkerPool::currentThread() : 0;
+  double* acc = p.lane_figures.data() + static_cast<size_t>(thread) * static_cast<size_t>(p.island_count) * 4;
+  for (int bi = b0; bi < b1; ++bi) {
+    const ContactBatch& b = p.batches[static_cast<size_t>(bi)];
+    for (int l = 0; l < kBatchLanes; ++l) {
+      if (b.count[l] <= 0) continue;
+      const size_t isl = static_cast<size_t>(b.island[l]);
+      double* a = acc + 4 * isl;
+      if (p.island_active[isl] > 0) {
+        foldFigure(a[0], b.sweep_delta[l]);
+        foldFigure(a[1], b.sweep_lambda[l]);
+      }
+      if (bias && p.bias_active[isl] > 0) {
+        foldFigure(a[2], b.bias_delta[l]);
+        foldFigure(a[3], b.bias_lambda[l]);
+      }
+    }
+  }
+}
+
+// Empties every thread's lane figures of the part's islands, before a
+// sweep folds into them.
+void clearLaneFigures(GraphProblem& p, const Part& part) {
+  const auto islands = static_cast<size_t>(p.island_count);
+  for (size_t t = 0; t < static_cast<size_t>(p.lane_figure_threads); ++t)
+    std::fill(p.lane_figures.begin() + static_cast<std::ptrdiff_t>(4 * (t * islands + static_cast<size_t>(part.island_begin))),
+              p.lane_figures.begin() + static_cast<std::ptrdiff_t>(4 * (t * islands + static_cast<size_t>(part.island_end))),
+              0.0);
+}
+
+// Each island's largest change and impulse of the sweep: from the lane
+// figures the threads folded (`which`: 0 the sweep's, 2 the correction's;
+// -1 none), and the row groups' with `groups`.
+void gatherSweep(GraphProblem& p, IslandFigures f, const Part& part, int which, bool groups) {
+  const auto islands = static_cast<size_t>(p.island_count);
+  for (std::int32_t k = part.island_begin; k < part.island_end; ++k) {
+    const auto i = static_cast<size_t>(k);
+    f.delta[i] = 0;
+    f.lambda[i] = 0;
+    if (which < 0) continue;
+    for (size_t t = 0; t < static_cast<size_t>(p.lane_figure_threads); ++t) {
+      const double* a = p.lane_figures.data() + 4 * (t * islands + i) + which;
+      foldFigure(f.delta[i], a[0]);
+      foldFigure(f.lambda[i], a[1]);
+    }
+  }
+  if (groups)
+    for (std::int32_t g = part.group_begin; g < part.group_end; ++g) {
+      const RowGroup& grp = p.groups[static_cast<size_t>(g)];
+      const auto i = static_cast<size_t>(grp.island);
+      if (f.active[i] > 0) {
+        foldFigure(f.delta[i], p.group_delta[static_cast<size_t>(g)]);
+        foldFigure(f.lambda[i], p.group_lambda[static_cast<size_t>(g)]);
+      }
+    }
+}
+
+// Each island's largest change and impulse of the sweep, read back from
+// the batches (the correction's own sweeps, which have no friction visit
+// to fold them in): the lanes' figures `delta` and `lambda` (none when
+// null), and the row groups' with `groups`.
 void reduceSweep(GraphProblem& p, IslandFigures f, const Part& part, LaneFigure delta, LaneFigure lambda,
                  bool groups) {
   std::fill(f.delta.begin() + part.island_begin, f.delta.begin() + part.island_end, 0.0);
@@ -433,9 +503,8 @@ void reduceSweep(GraphProblem& p, IslandFigures f, const Part& part, LaneFigure 
   const auto on = [&](std::int32_t island) { return f.active[static_cast<size_t>(island)] > 0; };
   const auto fold = [&](std::int32_t island, double d, double l) {
     const size_t i = static_cast<size_t>(island);
-    // NaN must win: a non-finite island never looks converged.
-    if (!(f.delta[i] >= d)) f.delta[i] = d;
-    if (!(f.lambda[i] >= l)) f.lambda[i] = l;
+    foldFigure(f.delta[i], d);
+    foldFigure(f.lambda[i], l);
   };
   if (delta)
     for (std::int32_t bi = part.batch_begin; bi < part.batch_end; ++bi) {
@@ -663,7 +732,10 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
         case Pass::Normals:
           o.kernels->solve_normals(p.batches.data(), b0, b1, body_data, bias_on ? sp_both : sp);
           break;
-        case Pass::Friction: o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp); break;
+        case Pass::Friction:
+          o.kernels->solve_friction(p.batches.data(), b0, b1, body_data, sp);
+          foldLaneFigures(p, b0, b1, bias_on);  // the batches' sweep is done
+          break;
         case Pass::Momentum:
           o.kernels->momentum(p.batches.data(), b0, b1, body_data, p.island_beta.data(), sp);
           break;
@@ -702,12 +774,13 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
   const bool batches = part.batch_end > part.batch_begin;
   for (int it = 0; it < o.iterations; ++it) {
     if (o.randomize_order || it == 0) orderColours(order, part, o.randomize_order, rng_state);
+    clearLaneFigures(p, part);  // before the passes: without overlap, a queued pass runs at once
     queue(Pass::Normals);
     if (batches) queue(Pass::Friction);  // a jointed scene without contacts has no friction pass
     endSweep();
-    reduceSweep(p, sweepFigures(p), part, &ContactBatch::sweep_delta, &ContactBatch::sweep_lambda, true);
+    gatherSweep(p, sweepFigures(p), part, batches ? 0 : -1, true);
     if (bias_on) {
-      reduceSweep(p, fusedBiasFigures(p), part, &ContactBatch::bias_delta, &ContactBatch::bias_lambda, false);
+      gatherSweep(p, fusedBiasFigures(p), part, batches ? 2 : -1, false);
       bias_on = stopConverged(fusedBiasFigures(p), part, o, ++bias_sweeps);
     }
     stats.last_max_delta = 0;
@@ -769,6 +842,8 @@ GraphSolveStats solveGraph(GraphProblem& p, std::span<SolverBody> bodies, const 
     p.island_prev_norm2.assign(n, 0.0);
     p.island_beta.assign(n, 0.0);
   }
+  p.lane_figure_threads = o.pool ? o.pool->threads() : 1;
+  p.lane_figures.resize(static_cast<size_t>(p.lane_figure_threads) * static_cast<size_t>(p.island_count) * 4);
   const int parts = partCount(p, o);
   p.part_stats.assign(static_cast<size_t>(parts), GraphSolveStats{});
   p.part_order.resize(static_cast<size_t>(parts));

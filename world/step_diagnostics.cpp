@@ -205,7 +205,8 @@ void watchJoints(WorldImpl& w) {
 
 // Contact c as a support of one body on another (the stack watcher), if
 // it is one, with the depth it stays sunk by.
-void addSupport(const WorldImpl& w, StepContext& ctx, const Contact& c, Real depth, const Vec3& up) {
+void addSupport(const WorldImpl& w, const Contact& c, Real depth, const Vec3& up,
+                std::vector<StepContext::Support>& supports) {
   if (!c.touching && !(depth > 0)) return;
   const Real cos45 = std::sqrt(Real(0.5));
   const Real along = c.normal.dot(up);  // the normal points from A to B
@@ -216,7 +217,7 @@ void addSupport(const WorldImpl& w, StepContext& ctx, const Contact& c, Real dep
   const bool sinks = !lower.isWorld() && w.body(lower).isDynamic();
   if (sinks && !((w.body(upper).position - w.body(lower).position).dot(up) > 0)) return;
   const Real stays = depth > 0 && depth <= w.settings_.slop ? depth : Real(0);
-  ctx.supports.push_back({sinks ? lower.index : -1, upper.index, stays});
+  supports.push_back({sinks ? lower.index : -1, upper.index, stays});
 }
 
 // Returns the deepest overlap of any contact (StepStats::max_penetration):
@@ -228,47 +229,60 @@ Real watchPenetration(WorldImpl& w, StepContext& ctx) {
   const Real tolerance = s.slop + s.penetration_drift;
   const Real g = w.gravity_.norm();
   const Vec3 up = g > 0 ? Vec3(-w.gravity_ / g) : Vec3::Zero();
-  ctx.supports.clear();
-  // The depths first, each contact on its own (on the pool's threads when
-  // there are many), then the reports in contact order. With no solver body
-  // but the world's nothing moved: every contact is still, its depth kept.
+  // Each contact on its own, on the pool's threads when there are many:
+  // its depth, and what the watchers take from it, per thread; then the
+  // threads' finds joined in range order, which is the contacts' order
+  // whatever the split. With no solver body but the world's nothing moved:
+  // every contact is still, its depth kept.
   const bool anything_moved = ctx.solver_count > 1;
   const auto still = [&](const Contact& c) {
     return !anything_moved || (!movedInStep(ctx, c.body_a) && !movedInStep(ctx, c.body_b));
   };
-  const auto depths = [&](int begin, int end) {
+  const int count = static_cast<int>(w.contacts_.size());
+  const bool parallel = w.pool_ && anything_moved && count >= kParallelContacts;
+  ctx.contact_watch.resize(parallel ? static_cast<size_t>(w.pool_->threads()) : 1);
+  const auto watchRange = [&](int begin, int end) {
+    StepContext::ContactWatch& cw = ctx.contact_watch[parallel ? static_cast<size_t>(WorkerPool::currentThread()) : 0];
+    cw.supports.clear();
+    cw.too_deep.clear();
+    cw.contacts = cw.points = 0;
+    cw.deepest = 0;
     for (int i = begin; i < end; ++i) {
       Contact& c = w.contacts_[static_cast<size_t>(i)];
-      if (c.enabled && !still(c)) c.depth_after = w.contactDepth(c);
+      if (!c.enabled) continue;
+      ++cw.contacts;
+      cw.points += c.count;
+      if (still(c)) {
+        cw.deepest = std::max(cw.deepest, c.depth_after);
+        continue;
+      }
+      const Real depth = c.depth_after = w.contactDepth(c);
+      cw.deepest = std::max(cw.deepest, depth);
+      if (g > 0) addSupport(w, c, depth, up, cw.supports);
+      if (depth > tolerance) cw.too_deep.push_back(i);
     }
   };
-  const int count = static_cast<int>(w.contacts_.size());
-  if (anything_moved) {
-    if (w.pool_ && count >= kParallelContacts) w.pool_->parallelFor(count, depths);
-    else depths(0, count);
-  }
-  // The same walk counts the step's contacts for StepStats (the list does
-  // not change after this stage).
+  if (parallel) w.pool_->parallelFor(count, watchRange);
+  else watchRange(0, count);
+  ctx.supports.clear();
   Real deepest = 0;
-  for (Contact& c : w.contacts_) {
-    if (!c.enabled) continue;
-    ++w.stats_.contacts;
-    w.stats_.contact_points += c.count;
-    if (still(c)) {
-      deepest = std::max(deepest, c.depth_after);
-      continue;
+  for (const StepContext::ContactWatch& cw : ctx.contact_watch) {
+    w.stats_.contacts += static_cast<int>(cw.contacts);
+    w.stats_.contact_points += static_cast<int>(cw.points);
+    deepest = std::max(deepest, cw.deepest);
+    ctx.supports.insert(ctx.supports.end(), cw.supports.begin(), cw.supports.end());
+    for (const std::int32_t i : cw.too_deep) {
+      const Contact& c = w.contacts_[static_cast<size_t>(i)];
+      const BodyId dyn = !c.body_b.isWorld() && w.body(c.body_b).isDynamic() ? c.body_b : c.body_a;
+      if (dyn.isWorld() || !w.body(dyn).isDynamic() || w.body(dyn).asleep) continue;
+      const BodyId other = dyn.index == c.body_a.index ? c.body_b : c.body_a;
+      w.diagnose(dyn.index, "penetration",
+                 "penetrates '" + (other.isWorld() ? std::string("world") : w.body(other).name) + "' by " +
+                     fmt(c.depth_after) + " m (slop " + fmt(s.slop) + " + penetration_drift " +
+                     fmt(s.penetration_drift) +
+                     " m): a hard impact, a stack sinking or a contact not resolved; more iterations or substeps",
+                 true);
     }
-    const Real depth = c.depth_after;
-    deepest = std::max(deepest, depth);
-    if (g > 0) addSupport(w, ctx, c, depth, up);
-    if (!(depth > tolerance)) continue;
-    const BodyId dyn = !c.body_b.isWorld() && w.body(c.body_b).isDynamic() ? c.body_b : c.body_a;
-    if (dyn.isWorld() || !w.body(dyn).isDynamic() || w.body(dyn).asleep) continue;
-    const BodyId other = dyn.index == c.body_a.index ? c.body_b : c.body_a;
-    w.diagnose(dyn.index, "penetration",
-               "penetrates '" + (other.isWorld() ? std::string("world") : w.body(other).name) + "' by " + fmt(depth) +
-                   " m (slop " + fmt(s.slop) + " + penetration_drift " + fmt(s.penetration_drift) +
-                   " m): a hard impact, a stack sinking or a contact not resolved; more iterations or substeps", true);
   }
   return deepest;
 }

@@ -186,6 +186,15 @@ struct StepContext {
     Real depth;
   };
   std::vector<Support> supports;
+  // The penetration watcher's threads: per thread, what its range of the
+  // contacts found (joined in range order: the contacts' order).
+  struct ContactWatch {
+    std::vector<Support> supports;
+    std::vector<std::int32_t> too_deep;  // contacts deeper than the tolerance
+    std::int64_t contacts = 0, points = 0;
+    Real deepest = 0;
+  };
+  std::vector<ContactWatch> contact_watch;
   std::vector<Real> sunk;
   std::vector<char> sunk_below;
   // Body pairs a joint keeps from colliding, sorted (collide, shouldCollide).

@@ -111,18 +111,26 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
     p.fat = want;
     return false;
   }
-  bool reinsert = !p.fat.contains(tight);
-  if (!reinsert) {
-    // A fat box far larger than wanted (the body slowed down) costs false
-    // pairs; shrink it once it overhangs by more than four margins.
-    const Real slack = 4 * margin_;
-    reinsert = ((p.fat.hi - want.hi).array() > slack).any() || ((want.lo - p.fat.lo).array() > slack).any();
-  }
-  if (!reinsert) return false;
+  if (!outgrown(p, tight, want)) return false;
   p.fat = want;
   tree_.update(p.leaf, want);
   markMoved(h);
   return true;
+}
+
+bool BroadPhase::outgrown(const Proxy& p, const Aabb& tight, const Aabb& want) const {
+  if (!p.fat.contains(tight)) return true;
+  // A fat box far larger than wanted (the body slowed down) costs false
+  // pairs; shrink it once it overhangs by more than four margins.
+  const Real slack = 4 * margin_;
+  return ((p.fat.hi - want.hi).array() > slack).any() || ((want.lo - p.fat.lo).array() > slack).any();
+}
+
+bool BroadPhase::moveChanges(int h, const Aabb& tight, const Vec3& displacement) const {
+  const Proxy& p = proxies_[h];
+  if (p.infinite) return !(p.fat.lo == tight.lo && p.fat.hi == tight.hi);
+  if (p.loner || !mayPairWithAny(p.group, p.mask)) return true;  // a loner's box is set; a proxy leaves the tree
+  return outgrown(p, tight, fatten(tight, displacement));
 }
 
 void BroadPhase::setFilter(int h, std::uint32_t group, std::uint32_t mask) {

@@ -83,6 +83,11 @@ class BroadPhase {
   // Returns true when the fat box changed (the proxy was re-inserted). An
   // infinite proxy takes `tight` as it is.
   bool moveProxy(int handle, const Aabb& tight, const Vec3& displacement = Vec3::Zero());
+  // Whether moveProxy with these arguments would change anything (a box
+  // kept, a proxy left out of the tree, a fat box re-inserted). It only
+  // reads, so threads may ask it for many proxies at once and hand the few
+  // that change to moveProxy one after another.
+  bool moveChanges(int handle, const Aabb& tight, const Vec3& displacement = Vec3::Zero()) const;
   // Collision filter of a proxy (default: group 1, every mask bit set).
   // A change re-pairs the proxy at the next updatePairs.
   void setFilter(int handle, std::uint32_t group, std::uint32_t mask);
@@ -191,6 +196,8 @@ class BroadPhase {
   };
 
   Aabb fatten(const Aabb& tight, const Vec3& displacement) const;
+  // Whether a proxy in the tree must be re-inserted with fat box `want`.
+  bool outgrown(const Proxy& p, const Aabb& tight, const Aabb& want) const;
   void markMoved(int handle);
   void leaveTree(int handle);
   void enterTree(int handle);

@@ -43,6 +43,11 @@ constexpr int kParallelLanes = 4096;
 // threads.
 constexpr int kParallelContacts = 4096;
 
+// Shapes below which their proxies are refitted on the calling thread
+// (world/world_proxies.cpp). A refit that keeps its fat box is a shape's
+// box, a few tens of nanoseconds.
+constexpr int kParallelProxies = 4096;
+
 // Constraints (manifolds and joints) below which the PGS islands are not
 // split into parts, one per thread (world/step_prepare.cpp): a part's
 // sweeps are handed over once per solve, a few microseconds against the

@@ -13,6 +13,13 @@ void applyForces(WorldImpl& w, StepContext& ctx);
 // Broadphase, narrowphase, contact cache (warm-start impulses matched by
 // feature), the pre-solve callback (world/world_contacts.cpp).
 void collide(WorldImpl& w, StepContext& ctx);
+// How far a shape's contacts must reach this step: the margin, and for a
+// continuous-collision body the distance it can travel in the step (the
+// narrowphase's margin and the broadphase's boxes alike).
+inline Real contactReach(const Body& b, Real margin, Real h) {
+  return b.ccd ? margin + h * b.linear_velocity.norm() : margin;
+}
+
 // Wakes what moving bodies touch, groups awake dynamic bodies into islands,
 // picks each island's solver (world/islands.cpp).
 void buildIslands(WorldImpl& w, StepContext& ctx);

@@ -20,12 +20,6 @@ std::uint64_t bodyPairKey(BodyId a, BodyId b) {
   return (std::uint64_t(lo) << 32) | hi;
 }
 
-// How far a shape's contacts must reach this step: the margin, and for a
-// continuous-collision body the distance it can travel in the step.
-Real reach(const Body& b, Real margin, Real h) {
-  return b.ccd ? margin + h * b.linear_velocity.norm() : margin;
-}
-
 // The pair's friction and restitution: the bodies' combined (geometric
 // mean of the frictions, the larger restitution, Bullet's and Box2D's
 // rules), or the pair's own material if one was set.
@@ -96,68 +90,6 @@ bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::in
 }
 
 }  // namespace
-
-void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
-  Body& b = body(id);
-  std::int32_t slot;
-  if (!free_shapes_.empty()) {
-    slot = free_shapes_.back();
-    free_shapes_.pop_back();
-  } else {
-    slot = static_cast<std::int32_t>(shapes_.size());
-    shapes_.emplace_back();
-    shapes_.back().alive = false;
-  }
-  ShapeRef& ref = shapes_[static_cast<size_t>(slot)];
-  ref.body = id;
-  ref.index = index_in_body;
-  ref.alive = true;
-  const ShapeDesc& shape = b.shapes[static_cast<size_t>(index_in_body)];
-  Aabb box = shapeAabb(shape, b.transform() * shape.local);
-  if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
-  ref.proxy = broadphase_.createProxy(box, slot, Vec3::Zero(), id.index);  // a body's own shapes never pair
-  proxy_fits_.resize(shapes_.size());  // the slot's box is fitted afresh
-  proxy_fits_[static_cast<size_t>(slot)] = {};
-  broadphase_.setFilter(ref.proxy, b.collision_group, b.collision_mask);
-  b.shape_ids[static_cast<size_t>(index_in_body)] = slot;
-}
-
-void WorldImpl::refitProxy(std::size_t slot, Real h) {
-  const ShapeRef& ref = shapes_[slot];
-  const Body& b = body(ref.body);
-  ProxyFit& fit = proxy_fits_[slot];
-  const Real margin = settings_.contact_margin;
-  if (fit.h == h && fit.margin == margin && fit.ccd == b.ccd && fit.x == b.position && fit.v == b.linear_velocity &&
-      fit.q.coeffs() == b.orientation.coeffs())
-    return;
-  fit = {b.position, b.linear_velocity, b.orientation, h, margin, b.ccd};
-  const ShapeDesc& shape = b.shapes[static_cast<size_t>(ref.index)];
-  Aabb box = shapeAabb(shape, b.transform() * shape.local);
-  if (!box.isInfinite()) box = box.expanded(reach(b, margin, h));  // as registerShape does
-  broadphase_.moveProxy(ref.proxy, box, b.linear_velocity * h);
-}
-
-void WorldImpl::forgetProxyFits() { proxy_fits_.assign(shapes_.size(), ProxyFit{}); }
-
-void WorldImpl::moveProxies(BodyId only, Real h) {
-  for (size_t slot = 0; slot < shapes_.size(); ++slot) {
-    const ShapeRef& ref = shapes_[slot];
-    if (!ref.alive || (!only.isWorld() && ref.body.index != only.index)) continue;
-    const Body& b = body(ref.body);
-    if (only.isWorld() && (b.type == BodyType::Static || b.asleep)) continue;
-    refitProxy(slot, h);
-  }
-}
-
-void WorldImpl::moveAwakeProxies(Real h) {
-  for (size_t slot = 0; slot < shapes_.size(); ++slot) {
-    const ShapeRef& ref = shapes_[slot];
-    if (!ref.alive || !ctx_.moves(static_cast<size_t>(ref.body.index))) continue;  // static or asleep: still there
-    const Body& b = body(ref.body);
-    if (b.type == BodyType::Static || b.asleep) continue;
-    refitProxy(slot, h);
-  }
-}
 
 void WorldImpl::setPairMaterial(BodyId a, BodyId b, Real friction, Real restitution) {
   if (!std::isfinite(friction) || friction < 0) throw InputError("pair material", "friction", "must be finite and >= 0");
@@ -275,7 +207,7 @@ bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys,
   if (recycleManifold(w, ba, bb, sa, sb, cached, old, cos_half_angle, out)) return true;
   const ShapeDesc& sda = ba.shapes[static_cast<size_t>(ra.index)];
   const ShapeDesc& sdb = bb.shapes[static_cast<size_t>(rb.index)];
-  const Real margin = std::max(reach(ba, w.settings_.contact_margin, h), reach(bb, w.settings_.contact_margin, h));
+  const Real margin = std::max(contactReach(ba, w.settings_.contact_margin, h), contactReach(bb, w.settings_.contact_margin, h));
   manifolds.clear();
   cairn::collide(sda, ba.transform() * sda.local, sdb, bb.transform() * sdb.local, margin, manifolds);
   for (const Manifold& m : manifolds) {

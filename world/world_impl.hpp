@@ -195,6 +195,13 @@ struct StepContext {
     Real deepest = 0;
   };
   std::vector<ContactWatch> contact_watch;
+  // The proxies' refit on the pool's threads (world/world_proxies.cpp):
+  // per thread, the shape slots whose proxies change, with their boxes.
+  struct ProxyMove {
+    std::int32_t slot;
+    Aabb box;
+  };
+  std::vector<std::vector<ProxyMove>> proxy_moves;
   std::vector<Real> sunk;
   std::vector<char> sunk_below;
   // Body pairs a joint keeps from colliding, sorted (collide, shouldCollide).
@@ -313,10 +320,13 @@ class WorldImpl {
   std::vector<ShapeId> overlap(const ShapeDesc& shape, const Transform& pose, const QueryFilter& f) const;
   // Moves the proxies of the body's shapes (or, for kWorldBody, of every
   // awake body that can move) so their fat boxes hold the shapes where they
-  // are now, stretched along v h (world/world_contacts.cpp).
+  // are now, stretched along v h (world/world_proxies.cpp).
   void moveProxies(BodyId only, Real h);
   void moveAwakeProxies(Real h);  // the step's end: only the bodies that moved (StepContext::moves)
   void refitProxy(std::size_t slot, Real h);  // the shape's fat box where its body now is
+  // refitProxy's first half: false if the slot's fit is unchanged, else
+  // the fit recorded and the shape's box (its tight box and reach) in `box`.
+  bool fitProxy(std::size_t slot, Real h, Aabb& box);
   void forgetProxyFits();  // every proxy refitted at its next move (proxy_fits_)
 
   // ----------------------------------------------------------------------

@@ -176,7 +176,15 @@ void BroadPhase::restore(const std::vector<ProxyState>& proxies, int free_head) 
 }
 
 bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
-  const bool changed = !moved_.empty() || !dirty_.empty();
+  const int moved = startPairUpdate();
+  PairQueries& q = queryPart(0);
+  q.clear();
+  queryMoved(0, moved, q);
+  return finishPairUpdate(1, out);
+}
+
+int BroadPhase::startPairUpdate() {
+  changed_ = !moved_.empty() || !dirty_.empty();
   if (filters_stale_) {
     group_union_ = mask_union_ = 0;
     for (const Proxy& p : proxies_)
@@ -189,14 +197,22 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
     const int h = loners_[k];
     if (mayPairWithAny(proxies_[h].group, proxies_[h].mask)) enterTree(h);
   }
-  // 1. Pairs found by querying each moved proxy. A query stops at
-  //    max_pairs_ other proxies (the bound in the header). A pair of two
-  //    moved proxies may be found twice (the sort below keeps one): keeping
-  //    it from one side only would lose it whenever that side's query was
-  //    the one cut short (a ground box under 900 new boxes).
-  fresh_.clear();
-  capped_.clear();
-  for (int m : moved_) {
+  return static_cast<int>(moved_.size());
+}
+
+BroadPhase::PairQueries& BroadPhase::queryPart(int part) {
+  if (query_parts_.size() <= static_cast<size_t>(part)) query_parts_.resize(static_cast<size_t>(part) + 1);
+  return query_parts_[static_cast<size_t>(part)];
+}
+
+// 1. Pairs found by querying each moved proxy. A query stops at max_pairs_
+//    other proxies (the bound in the header). A pair of two moved proxies
+//    may be found twice (the sort below keeps one): keeping it from one
+//    side only would lose it whenever that side's query was the one cut
+//    short (a ground box under 900 new boxes).
+void BroadPhase::queryMoved(int begin, int end, PairQueries& q) const {
+  for (int k = begin; k < end; ++k) {
+    const int m = moved_[static_cast<size_t>(k)];
     const Proxy& pm = proxies_[m];
     // A proxy whose filter meets no live proxy's has no pair to find
     // (the pair test below would reject every overlap).
@@ -206,9 +222,9 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
       const Proxy& po = proxies_[o];
       if (o == m || (pm.owner >= 0 && po.owner == pm.owner)) return true;
       if ((pm.group & po.mask) == 0 || (po.group & pm.mask) == 0) return true;
-      fresh_.emplace_back(std::min(m, o), std::max(m, o));
+      q.fresh.emplace_back(std::min(m, o), std::max(m, o));
       if (pm.infinite || po.infinite || ++found < max_pairs_) return true;
-      capped_.push_back(m);
+      q.capped.push_back(m);
       return false;
     };
     if (pm.infinite) {
@@ -216,16 +232,30 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
       // plane's box still rules out what lies wholly above it).
       for (int o = 0; o < static_cast<int>(proxies_.size()); ++o) {
         if (!proxies_[o].alive || proxies_[o].infinite) continue;
-        ++overlap_tests_;
+        ++q.tests;
         if (pm.fat.overlaps(proxies_[o].fat)) add(o);
       }
     } else {
-      tree_.query(pm.fat, [&](int leaf) { return add(tree_.user(leaf)); }, &overlap_tests_);
+      tree_.query(pm.fat, [&](int leaf) { return add(tree_.user(leaf)); }, &q.tests);
       for (int i : infinite_) {
-        ++overlap_tests_;
+        ++q.tests;
         if (pm.fat.overlaps(proxies_[i].fat)) add(i);
       }
     }
+  }
+}
+
+bool BroadPhase::finishPairUpdate(int parts, std::vector<std::pair<int, int>>& out) {
+  // The parts' finds, in the order of their ranges: the order one query
+  // after another would have found them in.
+  std::vector<std::pair<int, int>>& fresh = query_parts_[0].fresh;
+  std::swap(capped_, query_parts_[0].capped);
+  overlap_tests_ += query_parts_[0].tests;
+  for (size_t k = 1; k < static_cast<size_t>(parts); ++k) {
+    const PairQueries& q = query_parts_[k];
+    fresh.insert(fresh.end(), q.fresh.begin(), q.fresh.end());
+    capped_.insert(capped_.end(), q.capped.begin(), q.capped.end());
+    overlap_tests_ += q.tests;
   }
   // 2. Drop the stale pairs of proxies that moved or died, add the fresh.
   if (!dirty_.empty()) {
@@ -237,10 +267,10 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
   }
   // pairs_ stays sorted and unique between calls: sort only what is new
   // and merge it in (a scene at rest adds nothing and sorts nothing).
-  if (!fresh_.empty()) {
-    std::sort(fresh_.begin(), fresh_.end());
+  if (!fresh.empty()) {
+    std::sort(fresh.begin(), fresh.end());
     merged_.clear();  // std::inplace_merge would allocate a buffer each call
-    std::merge(pairs_.begin(), pairs_.end(), fresh_.begin(), fresh_.end(), std::back_inserter(merged_));
+    std::merge(pairs_.begin(), pairs_.end(), fresh.begin(), fresh.end(), std::back_inserter(merged_));
     std::swap(pairs_, merged_);
     pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
   }
@@ -250,7 +280,7 @@ bool BroadPhase::updatePairs(std::vector<std::pair<int, int>>& out) {
   moved_.clear();
   dirty_.clear();
   out.assign(pairs_.begin(), pairs_.end());
-  return changed;
+  return changed_;
 }
 
 }  // namespace cairn

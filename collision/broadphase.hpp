@@ -106,6 +106,22 @@ class BroadPhase {
   // the last call's.
   bool updatePairs(std::vector<std::pair<int, int>>& out);
 
+  // The same, with the queries of the proxies that moved split among
+  // threads: forRanges(n, fn) must call fn(part, begin, end) for `parts`
+  // contiguous ranges of [0, n) in ascending order of part (part k's
+  // range before part k + 1's; parts left out count as empty), at once or
+  // one after another. The queries
+  // only read the broadphase, and the parts' finds are joined in the order
+  // of their ranges: the pairs, cappedProxies() and overlapTests() are
+  // those of updatePairs, whatever the split.
+  template <class ForRanges>
+  bool updatePairs(std::vector<std::pair<int, int>>& out, int parts, ForRanges&& for_ranges) {
+    const int moved = startPairUpdate();
+    for (int k = 0; k < parts; ++k) queryPart(k).clear();  // made, and emptied, before the threads run
+    for_ranges(moved, [this](int part, int begin, int end) { queryMoved(begin, end, query_parts_[static_cast<size_t>(part)]); });
+    return finishPairUpdate(parts, out);
+  }
+
   // The broadphase as plain data (snapshots, world/snapshot_state.cpp):
   // per handle its fat box, user, owner, liveness and free-list link, and the head
   // of the free list. restore() rebuilds from that: the same handles, fat
@@ -195,6 +211,22 @@ class BroadPhase {
     std::uint32_t group = 1, mask = 0xffffffffu;  // setFilter
   };
 
+  // What one range of the moved proxies' queries found (updatePairs).
+  struct PairQueries {
+    std::vector<std::pair<int, int>> fresh;
+    std::vector<int> capped;
+    std::uint64_t tests = 0;
+    void clear() {
+      fresh.clear();
+      capped.clear();
+      tests = 0;
+    }
+  };
+  int startPairUpdate();  // returns how many proxies moved
+  PairQueries& queryPart(int part);
+  void queryMoved(int begin, int end, PairQueries& q) const;
+  bool finishPairUpdate(int parts, std::vector<std::pair<int, int>>& out);
+
   Aabb fatten(const Aabb& tight, const Vec3& displacement) const;
   // Whether a proxy in the tree must be re-inserted with fat box `want`.
   bool outgrown(const Proxy& p, const Aabb& tight, const Aabb& want) const;
@@ -216,8 +248,9 @@ class BroadPhase {
   std::vector<int> dirty_;     // handles whose old pairs are stale
   std::vector<std::pair<int, int>> pairs_;
   std::vector<std::pair<int, int>> merged_;  // scratch for merging fresh pairs in
-  std::vector<std::pair<int, int>> fresh_;  // scratch for updatePairs
+  std::vector<PairQueries> query_parts_;  // scratch for updatePairs, per part
   std::vector<int> capped_;
+  bool changed_ = false;  // updatePairs' answer, from its start
   int max_pairs_ = 64;
   // OR of the live proxies' groups and masks (mayPairWithAny); a superset
   // until updatePairs recomputes them after a proxy died or was refiltered.

@@ -4,9 +4,10 @@
 // each threshold is where that began to pay on the shared 2-core machine,
 // measured as its comment says. The solve's colours have their own rule
 // (solver/graph_solver.cpp). Results never depend on them: the threads
-// split a loop's items and every reduction runs in storage order on one
-// thread (tests/unit/solver_determinism_test.cpp runs scenes past all
-// five on 1, 2 and 4 threads).
+// split a loop's items, and every reduction runs in storage order on one
+// thread or is a maximum, whose value does not depend on the order
+// (tests/unit/solver_determinism_test.cpp runs scenes past all of them on
+// 1, 2 and 4 threads).
 #pragma once
 
 namespace cairn::detail {
@@ -21,6 +22,11 @@ namespace cairn::detail {
 // threads against 0.038 on one, while the 5,050-box pyramid (15,000
 // pairs) went from 13.9 to 9.2 ms.
 constexpr int kParallelPairs = 1024;
+
+// Moved proxies below which the broadphase's pair queries (one tree
+// descent each, about a microsecond on a 5,000-box tree) stay on the
+// calling thread (world/world_contacts.cpp).
+constexpr int kParallelMovedProxies = 256;
 
 // Batches below which the lanes are gathered, filled and factored on the
 // calling thread (world/step_prepare.cpp). With the fill kernel a batch
@@ -45,8 +51,10 @@ constexpr int kParallelContacts = 4096;
 
 // Shapes below which their proxies are refitted on the calling thread
 // (world/world_proxies.cpp). A refit that keeps its fat box is a shape's
-// box, a few tens of nanoseconds.
-constexpr int kParallelProxies = 4096;
+// box and a test, about a tenth of a microsecond (the 5,050-box pyramid's
+// refit took 0.70 ms a step on one thread): a thousand of them are worth
+// waking a worker for, as the pairs are.
+constexpr int kParallelProxies = 1024;
 
 // Constraints (manifolds and joints) below which the PGS islands are not
 // split into parts, one per thread (world/step_prepare.cpp): a part's

@@ -256,7 +256,16 @@ void collide(WorldImpl& w, StepContext& ctx) {
   // 1. Broadphase: move the proxies of bodies that can move.
   w.moveProxies(kWorldBody, h);
   broadphase_.setMaxPairsPerProxy(settings_.max_pairs_per_shape);
-  const bool pairs_changed = broadphase_.updatePairs(w.pairs_);
+  // The moved proxies' tree queries only read the tree: split among the
+  // pool's threads when there are enough of them (the same pairs in the
+  // same order whatever the split).
+  const int query_parts = w.pool_ ? w.pool_->threads() : 1;
+  const bool pairs_changed = broadphase_.updatePairs(w.pairs_, query_parts, [&](int moved, auto&& query) {
+    if (w.pool_ && moved >= kParallelMovedProxies)
+      w.pool_->parallelFor(moved, [&](int begin, int end) { query(WorkerPool::currentThread(), begin, end); });
+    else
+      query(0, 0, moved);
+  });
   std::vector<std::uint64_t>& jointed = ctx.jointed_pairs;  // for shouldCollide
   jointed.clear();
   for (const Joint& j : w.joints_)

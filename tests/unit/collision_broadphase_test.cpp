@@ -88,6 +88,47 @@ TEST(BroadPhasePairs, MatchBruteForceOnRandomOverlappingSetsThroughMovesAndRemov
   for (size_t k = 0; k + 2 < handles.size(); ++k) EXPECT_TRUE(bp.fatAabb(handles[k]).contains(tight[k]));
 }
 
+// The moved proxies' queries split into parts (as the World's threads run
+// them) find what one pass finds: the same pairs, the same capped proxies
+// in the same order, the same count of box tests, whatever the split and
+// in whatever order the parts run. Dense boxes and a cap of 6 pairs a
+// query, so that queries are cut short.
+TEST(BroadPhasePairs, QueriesSplitIntoPartsFindWhatOnePassFinds) {
+  std::mt19937 rng(7);
+  BroadPhase whole(0.1), split(0.1);
+  std::vector<int> handles;
+  for (int i = 0; i < 300; ++i) {
+    const Aabb box = randomBox(rng, 4, 0.8);
+    handles.push_back(whole.createProxy(box, i));
+    ASSERT_EQ(split.createProxy(box, i), handles.back());
+  }
+  whole.createProxy(Aabb{Vec3::Constant(-kInf), Vec3(kInf, 0, kInf)}, 1000);  // a plane: never capped
+  split.createProxy(Aabb{Vec3::Constant(-kInf), Vec3(kInf, 0, kInf)}, 1000);
+  for (BroadPhase* bp : {&whole, &split}) bp->setMaxPairsPerProxy(6);
+  std::uniform_real_distribution<Real> step(-0.3, 0.3);
+  for (int frame = 0; frame < 10; ++frame) {
+    const int parts = 1 + frame % 4;  // 1 to 4 parts, run last to first
+    std::vector<std::pair<int, int>> a, b;
+    whole.resetOverlapTests();
+    split.resetOverlapTests();
+    const bool changed_a = whole.updatePairs(a);
+    const bool changed_b = split.updatePairs(b, parts, [&](int n, auto&& query) {
+      for (int k = parts; k-- > 0;) query(k, k * n / parts, (k + 1) * n / parts);
+    });
+    ASSERT_EQ(changed_a, changed_b) << "frame " << frame;
+    ASSERT_EQ(a, b) << "frame " << frame;
+    ASSERT_EQ(whole.cappedProxies(), split.cappedProxies()) << "frame " << frame;
+    ASSERT_FALSE(whole.cappedProxies().empty()) << "frame " << frame;
+    ASSERT_EQ(whole.overlapTests(), split.overlapTests()) << "frame " << frame;
+    for (size_t k = 0; k < handles.size(); k += 2) {  // half of them move
+      const Vec3 d(step(rng), step(rng), step(rng));
+      const Aabb box{whole.fatAabb(handles[k]).lo + d, whole.fatAabb(handles[k]).hi + d};
+      whole.moveProxy(handles[k], box, d);
+      split.moveProxy(handles[k], box, d);
+    }
+  }
+}
+
 // n unit boxes on a grid with gaps wider than the fat margins: no pairs, and
 // finding that must cost O(n log n) box tests, not n^2 / 2.
 std::uint64_t gridPairTests(int side, std::vector<std::pair<int, int>>& pairs) {

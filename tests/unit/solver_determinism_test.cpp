@@ -175,10 +175,12 @@ TEST(Determinism, IslandsSweptAsOnePartPerThreadAreBitIdentical) {
   expectIdentical(one, run(s, kPileSteps, 4, Simd::Auto));
 }
 
-// The scenes above stay below the thresholds past which collide, the batch
-// fill, the impulse store and the watchers hand their loops to the pool
+// The scenes above stay below the thresholds past which collide, the
+// broadphase's queries, the proxies' refit, the batch fill, the impulse
+// store and the watchers hand their loops to the pool
 // (world/parallel_thresholds.hpp). A pyramid of base 60 (1,830 boxes,
-// about 5,400 touching manifolds) is past all four from its first step,
+// about 5,400 touching manifolds) is past all of them from its first step
+// (every proxy is new then, so every one is queried),
 // and is one island, large enough that its colours are swept by the flow
 // schedule (solver/colour_flow.hpp: each thread its share of every colour,
 // waiting only for the other threads' items that touched its bodies last);
@@ -193,6 +195,8 @@ TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
     const GraphProblem& g = in.stepContext().graph;
     const auto batches = static_cast<int>(g.batches.size());
     ASSERT_GE(static_cast<int>(in.pairs_.size()), detail::kParallelPairs);
+    ASSERT_GE(static_cast<int>(in.shapes_.size()), detail::kParallelProxies);
+    ASSERT_GE(static_cast<int>(in.shapes_.size()), detail::kParallelMovedProxies);
     ASSERT_GE(batches, detail::kParallelBatches);
     ASSERT_GE(batches * kBatchLanes, detail::kParallelLanes);
     ASSERT_GE(static_cast<int>(in.contacts().size()), detail::kParallelContacts);

@@ -184,27 +184,14 @@ std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>&
 // recycled manifold, else the narrowphase's. Reads the world only (the
 // pool's threads run it side by side); `manifolds` is scratch. Returns
 // whether a manifold was recycled.
-bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys, int pa, int pb, Real h,
-                 Real cos_half_angle, std::vector<Manifold>& manifolds, std::vector<Contact>& out) {
-  const std::vector<Contact>& old = w.old_contacts_;
-  std::int32_t sa = w.broadphase_.user(pa), sb = w.broadphase_.user(pb);
-  if (sa > sb) std::swap(sa, sb);
-  const ShapeRef& ra = w.shapes_[static_cast<size_t>(sa)];
-  const ShapeRef& rb = w.shapes_[static_cast<size_t>(sb)];
-  const Body& ba = w.body(ra.body);
-  const Body& bb = w.body(rb.body);
-  if (!w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
-  // Last step's contacts of this pair: their keys' high bits are the two
-  // shapes.
-  const auto cached = firstOldContact(old, old_keys, Contact::keyOf(sa, sb, -1));
-  if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were
-    for (auto it = cached; it != old.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
-      out.push_back(*it);
-      out.back().carried = true;
-    }
-    return false;
-  }
-  if (recycleManifold(w, ba, bb, sa, sb, cached, old, cos_half_angle, out)) return true;
+// A pair through the narrowphase: its manifolds as new contacts, each
+// point's anchors fixed on the two bodies. Kept out of collidePair, whose
+// common paths (a pair at rest, a recycled manifold) stay small: with this
+// inlined, GCC's choices for the rest changed with unrelated edits to this
+// file, and collide's time on one thread with them (docs/performance.md).
+[[gnu::noinline]] void narrowphasePair(const WorldImpl& w, const Body& ba, const Body& bb, const ShapeRef& ra,
+                                       const ShapeRef& rb, std::int32_t sa, std::int32_t sb, Real h,
+                                       std::vector<Manifold>& manifolds, std::vector<Contact>& out) {
   const ShapeDesc& sda = ba.shapes[static_cast<size_t>(ra.index)];
   const ShapeDesc& sdb = bb.shapes[static_cast<size_t>(rb.index)];
   const Real margin = std::max(contactReach(ba, w.settings_.contact_margin, h), contactReach(bb, w.settings_.contact_margin, h));
@@ -240,6 +227,30 @@ bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys,
     c.touching = true;
     out.push_back(c);
   }
+}
+
+bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys, int pa, int pb, Real h,
+                 Real cos_half_angle, std::vector<Manifold>& manifolds, std::vector<Contact>& out) {
+  const std::vector<Contact>& old = w.old_contacts_;
+  std::int32_t sa = w.broadphase_.user(pa), sb = w.broadphase_.user(pb);
+  if (sa > sb) std::swap(sa, sb);
+  const ShapeRef& ra = w.shapes_[static_cast<size_t>(sa)];
+  const ShapeRef& rb = w.shapes_[static_cast<size_t>(sb)];
+  const Body& ba = w.body(ra.body);
+  const Body& bb = w.body(rb.body);
+  if (!w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
+  // Last step's contacts of this pair: their keys' high bits are the two
+  // shapes.
+  const auto cached = firstOldContact(old, old_keys, Contact::keyOf(sa, sb, -1));
+  if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were
+    for (auto it = cached; it != old.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
+      out.push_back(*it);
+      out.back().carried = true;
+    }
+    return false;
+  }
+  if (recycleManifold(w, ba, bb, sa, sb, cached, old, cos_half_angle, out)) return true;
+  narrowphasePair(w, ba, bb, ra, rb, sa, sb, h, manifolds, out);
   return false;
 }
 

@@ -5,6 +5,7 @@
 // bodies out of penetration without adding momentum).
 #include "dynamics/forces.hpp"
 #include "dynamics/integrate.hpp"
+#include "world/parallel_thresholds.hpp"
 #include "world/step_stages.hpp"
 
 #include <string>
@@ -16,6 +17,18 @@ namespace {
 bool frozen(const StepContext& ctx, size_t body) {
   const std::int32_t isl = ctx.body_island[body];
   return ctx.any_frozen && isl >= 0 && ctx.frozen_island[static_cast<size_t>(isl)];
+}
+
+// Runs fn(i) for every body slot: on the pool's threads when there are
+// many (each body's update is its own).
+template <class F>
+void forBodies(WorldImpl& w, F&& fn) {
+  const int count = static_cast<int>(w.bodies_.size());
+  const auto range = [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) fn(static_cast<size_t>(i));
+  };
+  if (w.pool_ && count >= kParallelBodies) w.pool_->parallelFor(count, range);
+  else range(0, count);
 }
 
 }  // namespace
@@ -50,33 +63,38 @@ void applyForces(WorldImpl& w, StepContext& ctx) {
 void integrateVelocities(WorldImpl& w, StepContext& ctx) {
   const Real h = ctx.hs;
   ctx.orientation_offset.assign(w.bodies_.size(), Vec3::Zero());
-  for (size_t i = 0; i < w.bodies_.size(); ++i) {
-    if (!ctx.moves(i)) continue;
+  // A body whose gyroscopic solve fell short is marked here and reported
+  // after, in body order (the reports are not made on the threads).
+  ctx.body_flag.assign(w.bodies_.size(), 0);
+  forBodies(w, [&](size_t i) {
+    if (!ctx.moves(i)) return;
     Body& b = w.bodies_[i];
-    if (!b.alive || b.asleep || !b.isDynamic() || frozen(ctx, i)) continue;
+    if (!b.alive || b.asleep || !b.isDynamic() || frozen(ctx, i)) return;
     bool gyro_ok = true;
     ctx.orientation_offset[i] = integrateVelocity(b, w.gravity_, h, w.settings_.gyroscopic, &gyro_ok);
-    if (!gyro_ok)
-      w.diagnose(static_cast<std::int32_t>(i), "gyroscopic solve",
-                 "implicit-midpoint gyroscopic step not solved to 1e-10 |L| (h |w| = " +
-                     std::to_string(h * b.angular_velocity.norm()) +
-                     " rad): energy and |L| not conserved; substeps with h |w| < 1 restore it");
+    if (!gyro_ok) ctx.body_flag[i] = 1;
     // Safety net: cap the spin rate (off by default). stableNorm: |w|^2
     // must not overflow for the very spins the cap is there to catch.
     if (w.settings_.max_angular_velocity < kInf) {
       const Real rate = b.angular_velocity.stableNorm();
       if (rate > w.settings_.max_angular_velocity) b.angular_velocity *= w.settings_.max_angular_velocity / rate;
     }
-  }
+  });
+  for (size_t i = 0; i < w.bodies_.size(); ++i)
+    if (ctx.body_flag[i])
+      w.diagnose(static_cast<std::int32_t>(i), "gyroscopic solve",
+                 "implicit-midpoint gyroscopic step not solved to 1e-10 |L| (h |w| = " +
+                     std::to_string(h * w.bodies_[i].angular_velocity.norm()) +
+                     " rad): energy and |L| not conserved; substeps with h |w| < 1 restore it");
 }
 
 void integratePositions(WorldImpl& w, StepContext& ctx) {
   const Real h = ctx.hs;
   const OrientationIntegrator method = w.settings_.orientation;
-  for (size_t i = 0; i < w.bodies_.size(); ++i) {
-    if (!ctx.moves(i)) continue;
+  forBodies(w, [&](size_t i) {
+    if (!ctx.moves(i)) return;
     Body& b = w.bodies_[i];
-    if (!b.alive || b.asleep || b.type == BodyType::Static || frozen(ctx, i)) continue;
+    if (!b.alive || b.asleep || b.type == BodyType::Static || frozen(ctx, i)) return;
     const std::int32_t si = ctx.solver_of_body[i];
     if (ctx.has_pseudo && b.isDynamic() && si > 0 && si <= ctx.dynamic_count) {
       // Positions move at v + v_pseudo; the state velocity stays v.
@@ -86,7 +104,7 @@ void integratePositions(WorldImpl& w, StepContext& ctx) {
     } else {
       integratePosition(b, h, method, ctx.orientation_offset[i]);
     }
-  }
+  });
   ctx.has_pseudo = false;
 }
 

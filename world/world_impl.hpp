@@ -113,6 +113,7 @@ struct StepContext {
   std::vector<SolverBody> pseudo;      // split-impulse pseudo-velocities
   bool has_pseudo = false;
   std::vector<Vec3> orientation_offset;  // per body slot (implicit-midpoint gyroscopic term)
+  std::vector<char> body_flag;           // per body slot: a stage's mark, reported after its threads
 
   // Constraints by island: per contact (in contacts_) and per joint.
   std::vector<std::int32_t> contact_island;

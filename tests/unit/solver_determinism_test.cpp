@@ -176,8 +176,8 @@ TEST(Determinism, IslandsSweptAsOnePartPerThreadAreBitIdentical) {
 }
 
 // The scenes above stay below the thresholds past which collide, the
-// broadphase's queries, the proxies' refit, the batch fill, the impulse
-// store and the watchers hand their loops to the pool
+// broadphase's queries, the proxies' refit, the integration, the batch
+// fill, the impulse store and the watchers hand their loops to the pool
 // (world/parallel_thresholds.hpp). A pyramid of base 60 (1,830 boxes,
 // about 5,400 touching manifolds) is past all of them from its first step
 // (every proxy is new then, so every one is queried),
@@ -197,6 +197,7 @@ TEST(Determinism, LargePyramidTakesEveryThreadedPathAndIsBitIdentical) {
     ASSERT_GE(static_cast<int>(in.pairs_.size()), detail::kParallelPairs);
     ASSERT_GE(static_cast<int>(in.shapes_.size()), detail::kParallelProxies);
     ASSERT_GE(static_cast<int>(in.shapes_.size()), detail::kParallelMovedProxies);
+    ASSERT_GE(static_cast<int>(in.bodies().size()), detail::kParallelBodies);
     ASSERT_GE(batches, detail::kParallelBatches);
     ASSERT_GE(batches * kBatchLanes, detail::kParallelLanes);
     ASSERT_GE(static_cast<int>(in.contacts().size()), detail::kParallelContacts);

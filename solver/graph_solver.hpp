@@ -122,7 +122,13 @@ struct GraphProblem {
   // planned at the first sweep.
   PassPipeline pipeline;
 
+  // Whether the layout (colours, batches, groups, parts) is the one its
+  // maker last made: false after clear(). The World keeps a layout from
+  // step to step while the constraints it was made from are the same.
+  bool laid_out = false;
+
   void clear() {
+    laid_out = false;
     batches.clear();
     groups.clear();
     rows.clear();

@@ -61,6 +61,7 @@ struct GraphItem {
   std::int32_t index;  // joint or contact
   std::int32_t a, b;   // solver body indices
   std::int32_t island;
+  bool operator==(const GraphItem&) const = default;
 };
 
 // What solver.method = "auto" learns of an island before choosing its
@@ -129,6 +130,16 @@ struct StepContext {
   std::vector<int> pair_recycled;
   // Scratch of the colouring.
   std::vector<GraphItem> items, sorted_items;
+  // What the graph's layout was last made from (layoutGraph): the items
+  // and the few counts it reads besides. While they are the same, so is
+  // the layout, and it is kept (GraphProblem::laid_out says it still is).
+  struct LayoutInputs {
+    std::vector<GraphItem> items;
+    std::int32_t dynamic_count = -1, island_count = -1;
+    int threads = 0;
+    bool randomize_order = false;
+    std::int64_t made = 0;  // layouts made (not kept) so far
+  } layout_inputs;
   std::vector<std::int32_t> colour_of, adj_start, adj, level, queue, level_start;
   std::vector<std::int32_t> island_part, island_work;  // per island: its part of the graph, its constraints
   std::vector<std::int32_t> groups_in, manifolds_in, group_fill, lane_fill;

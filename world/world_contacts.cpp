@@ -414,10 +414,9 @@ void collide(WorldImpl& w, StepContext& ctx) {
 // Begin events are emitted after the solve so they carry the impulse of
 // their first step; End events name contacts that no longer touch (and
 // those removed with a body or shape since the last step).
-void emitContactEvents(WorldImpl& w, StepContext&) {
+void emitContactEvents(WorldImpl& w, StepContext& ctx) {
   const std::vector<Contact>& contacts_ = w.contacts_;
   const std::vector<Contact>& old = w.old_contacts_;
-  std::vector<ContactEvent>& contact_events_ = w.contact_events_;
   const auto body = [&](BodyId id) -> const Body& { return w.body(id); };
   const auto event = [&](const Contact& c, ContactEvent::Type type) {
     ContactEvent e;
@@ -430,26 +429,60 @@ void emitContactEvents(WorldImpl& w, StepContext&) {
     e.normal = c.normal;
     return e;
   };
-  for (const Contact& c : contacts_) {
-    if (!c.began || !c.enabled) continue;
-    ContactEvent e = event(c, ContactEvent::Type::Begin);
-    int deepest = 0;
-    for (int i = 0; i < c.count; ++i)
-      if (c.points[i].depth > c.points[deepest].depth) deepest = i;
-    e.point = body(c.body_a).transform().apply(c.points[deepest].local_a);
-    e.impulse = c.totalNormalImpulse();
-    contact_events_.push_back(e);
-  }
-  // Both lists are sorted by key (collide sorts them): one merge walk
-  // finds last step's contacts that are gone.
-  auto now = contacts_.begin();
-  for (const Contact& o : old) {
-    while (now != contacts_.end() && now->key() < o.key()) ++now;
-    if (!o.touching || !o.enabled || (now != contacts_.end() && now->key() == o.key())) continue;
-    contact_events_.push_back(event(o, ContactEvent::Type::End));
+  // Begin events of contacts [begin, end), and End events of last step's
+  // contacts [old_begin, old_end): both lists are sorted by key (collide
+  // sorts them), so one merge walk finds last step's contacts that are gone.
+  const auto begins = [&](int begin, int end, std::vector<ContactEvent>& out) {
+    for (int k = begin; k < end; ++k) {
+      const Contact& c = contacts_[static_cast<size_t>(k)];
+      if (!c.began || !c.enabled) continue;
+      ContactEvent e = event(c, ContactEvent::Type::Begin);
+      int deepest = 0;
+      for (int i = 0; i < c.count; ++i)
+        if (c.points[i].depth > c.points[deepest].depth) deepest = i;
+      e.point = body(c.body_a).transform().apply(c.points[deepest].local_a);
+      e.impulse = c.totalNormalImpulse();
+      out.push_back(e);
+    }
+  };
+  const auto ends = [&](int old_begin, int old_end, std::vector<ContactEvent>& out) {
+    if (old_begin >= old_end) return;
+    const std::uint64_t first = old[static_cast<size_t>(old_begin)].key();
+    auto now = std::partition_point(contacts_.begin(), contacts_.end(), [&](const Contact& c) { return c.key() < first; });
+    for (int k = old_begin; k < old_end; ++k) {
+      const Contact& o = old[static_cast<size_t>(k)];
+      while (now != contacts_.end() && now->key() < o.key()) ++now;
+      if (!o.touching || !o.enabled || (now != contacts_.end() && now->key() == o.key())) continue;
+      out.push_back(event(o, ContactEvent::Type::End));
+    }
+  };
+  // On the pool's threads when the lists are long, each thread's events
+  // kept apart and joined in range order: the order of one thread's walks.
+  const int n = static_cast<int>(contacts_.size()), n_old = static_cast<int>(old.size());
+  std::vector<ContactEvent>& events = w.contact_events_;
+  if (w.pool_ && n + n_old >= kParallelContacts) {
+    const auto threads = static_cast<size_t>(w.pool_->threads());
+    ctx.begin_events.resize(threads);
+    ctx.end_events.resize(threads);
+    w.pool_->parallelFor(w.pool_->threads(), [&](int t0, int t1) {
+      for (int t = t0; t < t1; ++t) {
+        const auto T = static_cast<std::int64_t>(threads);
+        std::vector<ContactEvent>& b = ctx.begin_events[static_cast<size_t>(t)];
+        std::vector<ContactEvent>& e = ctx.end_events[static_cast<size_t>(t)];
+        b.clear();
+        e.clear();
+        begins(static_cast<int>(t * n / T), static_cast<int>((t + 1) * n / T), b);
+        ends(static_cast<int>(t * n_old / T), static_cast<int>((t + 1) * n_old / T), e);
+      }
+    });
+    for (const std::vector<ContactEvent>& b : ctx.begin_events) events.insert(events.end(), b.begin(), b.end());
+    for (const std::vector<ContactEvent>& e : ctx.end_events) events.insert(events.end(), e.begin(), e.end());
+  } else {
+    begins(0, n, events);
+    ends(0, n_old, events);
   }
   for (const Contact& o : w.ended_contacts_)
-    if (o.touching && o.enabled) contact_events_.push_back(event(o, ContactEvent::Type::End));
+    if (o.touching && o.enabled) events.push_back(event(o, ContactEvent::Type::End));
   w.ended_contacts_.clear();
 }
 

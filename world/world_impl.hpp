@@ -207,6 +207,10 @@ struct StepContext {
     Real deepest = 0;
   };
   std::vector<ContactWatch> contact_watch;
+  // The contact events' threads (world/world_contacts.cpp): per thread,
+  // the Begin events of its range of the contacts and the End events of
+  // its range of last step's.
+  std::vector<std::vector<ContactEvent>> begin_events, end_events;
   // The proxies' refit on the pool's threads (world/world_proxies.cpp):
   // per thread, the shape slots whose proxies change, with their boxes.
   struct ProxyMove {

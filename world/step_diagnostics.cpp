@@ -241,12 +241,14 @@ Real watchPenetration(WorldImpl& w, StepContext& ctx) {
   const int count = static_cast<int>(w.contacts_.size());
   const bool parallel = w.pool_ && anything_moved && count >= kParallelContacts;
   ctx.contact_watch.resize(parallel ? static_cast<size_t>(w.pool_->threads()) : 1);
-  const auto watchRange = [&](int begin, int end) {
-    StepContext::ContactWatch& cw = ctx.contact_watch[parallel ? static_cast<size_t>(WorkerPool::currentThread()) : 0];
+  for (StepContext::ContactWatch& cw : ctx.contact_watch) {  // a thread given no range leaves its own empty
     cw.supports.clear();
     cw.too_deep.clear();
     cw.contacts = cw.points = 0;
     cw.deepest = 0;
+  }
+  const auto watchRange = [&](int begin, int end) {
+    StepContext::ContactWatch& cw = ctx.contact_watch[parallel ? static_cast<size_t>(WorkerPool::currentThread()) : 0];
     for (int i = begin; i < end; ++i) {
       Contact& c = w.contacts_[static_cast<size_t>(i)];
       if (!c.enabled) continue;

@@ -77,9 +77,9 @@ void refitProxies(WorldImpl& w, StepContext& ctx, Real h, Take&& take) {
     return;
   }
   ctx.proxy_moves.resize(static_cast<size_t>(w.pool_->threads()));
+  for (std::vector<StepContext::ProxyMove>& moves : ctx.proxy_moves) moves.clear();  // a thread given no range adds none
   w.pool_->parallelFor(count, [&](int begin, int end) {
     std::vector<StepContext::ProxyMove>& moves = ctx.proxy_moves[static_cast<size_t>(WorkerPool::currentThread())];
-    moves.clear();
     for (int k = begin; k < end; ++k) {
       const auto slot = static_cast<size_t>(k);
       Aabb box;

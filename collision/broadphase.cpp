@@ -95,11 +95,11 @@ void BroadPhase::destroyProxy(int h) {
 }
 
 bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
+  if (!moveChanges(h, tight, displacement)) return false;
   Proxy& p = proxies_[h];
   if (p.infinite) {
     // An infinite proxy (a plane) keeps the box it is given: a moved plane's
     // half-space bounds something else.
-    if (p.fat.lo == tight.lo && p.fat.hi == tight.hi) return false;
     p.fat = tight;
     markMoved(h);
     return true;
@@ -111,7 +111,6 @@ bool BroadPhase::moveProxy(int h, const Aabb& tight, const Vec3& displacement) {
     p.fat = want;
     return false;
   }
-  if (!outgrown(p, tight, want)) return false;
   p.fat = want;
   tree_.update(p.leaf, want);
   markMoved(h);
@@ -126,6 +125,7 @@ bool BroadPhase::outgrown(const Proxy& p, const Aabb& tight, const Aabb& want) c
   return ((p.fat.hi - want.hi).array() > slack).any() || ((want.lo - p.fat.lo).array() > slack).any();
 }
 
+// What moveProxy would do, decided without doing it (moveProxy acts on it).
 bool BroadPhase::moveChanges(int h, const Aabb& tight, const Vec3& displacement) const {
   const Proxy& p = proxies_[h];
   if (p.infinite) return !(p.fat.lo == tight.lo && p.fat.hi == tight.hi);

@@ -110,10 +110,10 @@ class BroadPhase {
   // threads: forRanges(n, fn) must call fn(part, begin, end) for `parts`
   // contiguous ranges of [0, n) in ascending order of part (part k's
   // range before part k + 1's; parts left out count as empty), at once or
-  // one after another. The queries
-  // only read the broadphase, and the parts' finds are joined in the order
-  // of their ranges: the pairs, cappedProxies() and overlapTests() are
-  // those of updatePairs, whatever the split.
+  // one after another. The queries only read the broadphase, and the
+  // parts' finds are joined in the order of their ranges: the pairs,
+  // cappedProxies() and overlapTests() are those of updatePairs, whatever
+  // the split.
   template <class ForRanges>
   bool updatePairs(std::vector<std::pair<int, int>>& out, int parts, ForRanges&& for_ranges) {
     const int moved = startPairUpdate();

@@ -430,6 +430,9 @@ void foldFigure(double& x, double d) {
   if (x == x && !(x >= d)) x = d;
 }
 
+// Where a fold's figures sit in an island's four of lane_figures.
+constexpr int kSweepFigures = 0, kBiasFigures = 2;
+
 // The lane figures of batches [b0, b1) into the calling thread's row of
 // GraphProblem::lane_figures, after their friction visit: the sweep's
 // where the island's sweeps go on, and with `bias` the correction's where
@@ -444,12 +447,12 @@ void foldLaneFigures(GraphProblem& p, int b0, int b1, bool bias) {
       const size_t isl = static_cast<size_t>(b.island[l]);
       double* a = acc + 4 * isl;
       if (p.island_active[isl] > 0) {
-        foldFigure(a[0], b.sweep_delta[l]);
-        foldFigure(a[1], b.sweep_lambda[l]);
+        foldFigure(a[kSweepFigures], b.sweep_delta[l]);
+        foldFigure(a[kSweepFigures + 1], b.sweep_lambda[l]);
       }
       if (bias && p.bias_active[isl] > 0) {
-        foldFigure(a[2], b.bias_delta[l]);
-        foldFigure(a[3], b.bias_lambda[l]);
+        foldFigure(a[kBiasFigures], b.bias_delta[l]);
+        foldFigure(a[kBiasFigures + 1], b.bias_lambda[l]);
       }
     }
   }
@@ -465,31 +468,35 @@ void clearLaneFigures(GraphProblem& p, const Part& part) {
               0.0);
 }
 
+// The part's row groups' largest change and impulse into their islands'
+// figures, where the islands' sweeps go on.
+void foldGroupFigures(const GraphProblem& p, IslandFigures f, const Part& part) {
+  for (std::int32_t g = part.group_begin; g < part.group_end; ++g) {
+    const auto i = static_cast<size_t>(p.groups[static_cast<size_t>(g)].island);
+    if (f.active[i] > 0) {
+      foldFigure(f.delta[i], p.group_delta[static_cast<size_t>(g)]);
+      foldFigure(f.lambda[i], p.group_lambda[static_cast<size_t>(g)]);
+    }
+  }
+}
+
 // Each island's largest change and impulse of the sweep: from the lane
-// figures the threads folded (`which`: 0 the sweep's, 2 the correction's;
-// -1 none), and the row groups' with `groups`.
+// figures the threads folded (`which`: kSweepFigures or kBiasFigures; a
+// part without batches folded none, and its rows hold zeros), and the row
+// groups' with `groups`.
 void gatherSweep(GraphProblem& p, IslandFigures f, const Part& part, int which, bool groups) {
   const auto islands = static_cast<size_t>(p.island_count);
   for (std::int32_t k = part.island_begin; k < part.island_end; ++k) {
     const auto i = static_cast<size_t>(k);
     f.delta[i] = 0;
     f.lambda[i] = 0;
-    if (which < 0) continue;
     for (size_t t = 0; t < static_cast<size_t>(p.lane_figure_threads); ++t) {
       const double* a = p.lane_figures.data() + 4 * (t * islands + i) + which;
       foldFigure(f.delta[i], a[0]);
       foldFigure(f.lambda[i], a[1]);
     }
   }
-  if (groups)
-    for (std::int32_t g = part.group_begin; g < part.group_end; ++g) {
-      const RowGroup& grp = p.groups[static_cast<size_t>(g)];
-      const auto i = static_cast<size_t>(grp.island);
-      if (f.active[i] > 0) {
-        foldFigure(f.delta[i], p.group_delta[static_cast<size_t>(g)]);
-        foldFigure(f.lambda[i], p.group_lambda[static_cast<size_t>(g)]);
-      }
-    }
+  if (groups) foldGroupFigures(p, f, part);
 }
 
 // Each island's largest change and impulse of the sweep, read back from
@@ -512,11 +519,7 @@ void reduceSweep(GraphProblem& p, IslandFigures f, const Part& part, LaneFigure 
       for (int l = 0; l < kBatchLanes; ++l)
         if (b.count[l] > 0 && on(b.island[l])) fold(b.island[l], (b.*delta)[l], (b.*lambda)[l]);
     }
-  if (groups)
-    for (std::int32_t g = part.group_begin; g < part.group_end; ++g) {
-      const RowGroup& grp = p.groups[static_cast<size_t>(g)];
-      if (on(grp.island)) fold(grp.island, p.group_delta[static_cast<size_t>(g)], p.group_lambda[static_cast<size_t>(g)]);
-    }
+  if (groups) foldGroupFigures(p, f, part);
 }
 
 // Stops the islands that reached the tolerance or a round-off fixed point;
@@ -778,9 +781,9 @@ GraphSolveStats sweepPart(GraphProblem& p, const Part& part, std::vector<std::in
     queue(Pass::Normals);
     if (batches) queue(Pass::Friction);  // a jointed scene without contacts has no friction pass
     endSweep();
-    gatherSweep(p, sweepFigures(p), part, batches ? 0 : -1, true);
+    gatherSweep(p, sweepFigures(p), part, kSweepFigures, true);
     if (bias_on) {
-      gatherSweep(p, fusedBiasFigures(p), part, batches ? 2 : -1, false);
+      gatherSweep(p, fusedBiasFigures(p), part, kBiasFigures, false);
       bias_on = stopConverged(fusedBiasFigures(p), part, o, ++bias_sweeps);
     }
     stats.last_max_delta = 0;

@@ -202,6 +202,18 @@ bool pgsIsland(const StepContext& ctx, std::int32_t isl) {
   return ctx.island_method[static_cast<size_t>(isl)] == SolverMethod::PGS;
 }
 
+// A layout kept for another (sub)step: its row groups are built again at
+// the new pose (prepareConstraints), and the schedules planned on it are
+// kept only with `keep_plans` (a group's bodies are read from its rows).
+void keepLayout(GraphProblem& g, bool keep_plans) {
+  g.rows.clear();
+  g.correction_swept = false;
+  if (!keep_plans) {
+    g.flow.reset();
+    g.pipeline.reset();
+  }
+}
+
 // Steps 1 to 6 of the preparation: which constraints the graph holds, their
 // order and colours, and where each goes (a row group or a batch lane).
 // What they read (the islands, the contacts, the joints) is fixed for the
@@ -259,12 +271,7 @@ void layoutGraph(WorldImpl& w, StepContext& ctx) {
   StepContext::LayoutInputs& made = ctx.layout_inputs;
   if (g.laid_out && made.dynamic_count == ctx.dynamic_count && made.island_count == ctx.island_count &&
       made.threads == threads && made.randomize_order == s.randomize_order && made.items == items) {
-    g.rows.clear();  // the row groups are built again at this pose (prepareConstraints)
-    g.correction_swept = false;
-    if (!g.groups.empty()) {
-      g.flow.reset();
-      g.pipeline.reset();
-    }
+    keepLayout(g, g.groups.empty());
     return;
   }
   g.clear();
@@ -501,10 +508,7 @@ void prepareConstraints(WorldImpl& w, StepContext& ctx) {
     storeLaneImpulses(w, ctx);
   }
   if (same_graph) {
-    g.rows.clear();  // the row groups are built again below, at this substep's pose
-    g.flow.reset();
-    g.pipeline.reset();
-    g.correction_swept = false;
+    keepLayout(g, false);
   } else {
     layoutGraph(w, ctx);
   }

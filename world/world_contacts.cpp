@@ -304,10 +304,17 @@ void collide(WorldImpl& w, StepContext& ctx) {
     std::swap(old_contacts_, contacts_);
     contacts_.clear();
     const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
-    if (!std::is_sorted(old_contacts_.begin(), old_contacts_.end(), by_key))
+    // Last step's keys, read once and checked for order in their own
+    // array (a walk over the contacts would read a 704-byte contact each).
+    const auto readKeys = [&] {
+      old_keys.resize(old_contacts_.size());
+      for (size_t i = 0; i < old_contacts_.size(); ++i) old_keys[i] = old_contacts_[i].key();
+    };
+    readKeys();
+    if (!std::is_sorted(old_keys.begin(), old_keys.end())) {
       std::sort(old_contacts_.begin(), old_contacts_.end(), by_key);
-    old_keys.resize(old_contacts_.size());
-    for (size_t i = 0; i < old_contacts_.size(); ++i) old_keys[i] = old_contacts_[i].key();
+      readKeys();
+    }
     const Real cos_half_angle = std::cos(settings_.recycle_angle / 2);
     const auto pairRange = [&](int begin, int end, std::vector<Contact>& out, std::vector<Manifold>& manifolds) {
       int recycled = 0;

@@ -8,6 +8,7 @@
 #include "world/step_stages.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace cairn::detail {
@@ -316,42 +317,65 @@ void collide(WorldImpl& w, StepContext& ctx) {
       readKeys();
     }
     const Real cos_half_angle = std::cos(settings_.recycle_angle / 2);
-    const auto pairRange = [&](int begin, int end, std::vector<Contact>& out, std::vector<Manifold>& manifolds) {
-      int recycled = 0;
+    // A range of pairs: appends their contacts to `out`, counts the
+    // recycled manifolds, and says whether the contacts came in key order
+    // (each key read as it is written, not in a walk over the list after).
+    const auto pairRange = [&](int begin, int end, std::vector<Contact>& out, std::vector<Manifold>& manifolds,
+                               int& recycled) {
+      bool sorted = true;
       for (int k = begin; k < end; ++k) {
         const auto& [pa, pb] = w.pairs_[static_cast<size_t>(k)];
+        const size_t first = out.size();
         recycled += collidePair(w, old_keys, pa, pb, h, cos_half_angle, manifolds, out);
+        for (size_t i = std::max<size_t>(first, 1); i < out.size(); ++i) sorted = sorted && !(out[i].key() < out[i - 1].key());
       }
-      return recycled;
+      return sorted;
     };
     const int pair_count = static_cast<int>(w.pairs_.size());
     if (ctx.pair_manifolds.empty()) ctx.pair_manifolds.resize(1);  // the calling thread's scratch
-    // The pairs are independent: split among the pool's threads, each
-    // appending to its own list, the lists joined in pair order (the same
-    // contacts in the same order whatever the split). The user's filter
-    // callback is called from the stepping thread only.
+    // The pairs are independent: split among the pool's threads in ranges
+    // sized by last step's time (world/cost_split.hpp), each appending to
+    // its own list, the lists joined in pair order (the same contacts in
+    // the same order whatever the split). The user's filter callback is
+    // called from the stepping thread only.
+    bool in_order = true;
     if (w.pool_ && pair_count >= kParallelPairs && !w.filter_callback_) {
       const auto threads = static_cast<size_t>(w.pool_->threads());
       ctx.pair_contacts.resize(threads);
       ctx.pair_manifolds.resize(threads);
       ctx.pair_recycled.assign(threads, 0);
-      w.pool_->parallelFor(pair_count, [&](int begin, int end) {
-        const auto t = static_cast<size_t>(WorkerPool::currentThread());
-        std::vector<Contact>& out = t == 0 ? contacts_ : ctx.pair_contacts[t];
-        if (t > 0) out.clear();
-        ctx.pair_recycled[t] = pairRange(begin, end, out, ctx.pair_manifolds[t]);
+      ctx.pair_sorted.assign(threads, 1);
+      for (size_t t = 1; t < threads; ++t) ctx.pair_contacts[t].clear();  // a thread may have no pairs
+      ctx.pair_split.plan(pair_count, static_cast<int>(threads));
+      w.pool_->parallelFor(static_cast<int>(threads), [&](int first, int last) {  // one range per thread
+        for (int r = first; r < last; ++r) {
+          const auto t = static_cast<size_t>(r);
+          const auto start = std::chrono::steady_clock::now();
+          std::vector<Contact>& out = t == 0 ? contacts_ : ctx.pair_contacts[t];
+          ctx.pair_sorted[t] =
+              pairRange(ctx.pair_split.begin(r), ctx.pair_split.end(r), out, ctx.pair_manifolds[t], ctx.pair_recycled[t]);
+          ctx.pair_split.record(r, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        }
       });
       for (size_t t = 0; t < threads; ++t) {
-        if (t > 0) contacts_.insert(contacts_.end(), ctx.pair_contacts[t].begin(), ctx.pair_contacts[t].end());
+        if (t > 0) {
+          const std::vector<Contact>& part = ctx.pair_contacts[t];
+          if (!part.empty() && !contacts_.empty() && part.front().key() < contacts_.back().key()) in_order = false;
+          contacts_.insert(contacts_.end(), part.begin(), part.end());
+        }
+        in_order = in_order && ctx.pair_sorted[t];
         w.stats_.recycled_contacts += ctx.pair_recycled[t];
       }
     } else {
-      w.stats_.recycled_contacts += pairRange(0, pair_count, contacts_, ctx.pair_manifolds[0]);
+      int recycled = 0;
+      in_order = pairRange(0, pair_count, contacts_, ctx.pair_manifolds[0], recycled);
+      w.stats_.recycled_contacts += recycled;
     }
     // Contacts in key order (deterministic, and for the lookup below). The
     // broadphase hands pairs over in a stable order, so this is usually
-    // sorted already: checking first spares moving every contact.
-    if (!std::is_sorted(contacts_.begin(), contacts_.end(), by_key)) std::stable_sort(contacts_.begin(), contacts_.end(), by_key);
+    // sorted already: checked as they were written, which spares moving
+    // every contact.
+    if (!in_order) std::stable_sort(contacts_.begin(), contacts_.end(), by_key);
   }
 
   // 3. Warm start: carry impulses from last step's points with the same

@@ -26,6 +26,7 @@
 #include "solver/pgs.hpp"
 #include "solver/solver_body.hpp"
 #include "solver/worker_pool.hpp"
+#include "world/cost_split.hpp"
 #include "world/pool_watch.hpp"
 
 #include <memory>
@@ -128,6 +129,8 @@ struct StepContext {
   std::vector<std::vector<Contact>> pair_contacts;  // collide's threads: per thread, the contacts of its pairs
   std::vector<std::vector<Manifold>> pair_manifolds;  // per thread, narrowphase scratch ([0]: the calling thread)
   std::vector<int> pair_recycled;
+  std::vector<std::uint8_t> pair_sorted;  // per thread: whether its contacts came in key order
+  CostSplit pair_split;                   // collide's threads: their ranges of pairs, by last step's time
   // Scratch of the colouring.
   std::vector<GraphItem> items, sorted_items;
   // What the graph's layout was last made from (layoutGraph): the items

@@ -27,6 +27,7 @@
 #include "validation/plot_script.hpp"
 #include "validation/report.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -93,7 +94,14 @@ int bench(const BenchOptions& o) {
   m["format"] = "cairn bench 1";
   m["command"] = quoteCommand(o);
   m["date"] = utcNow();
-  m["machine"] = Json{{"cpus", machine.cpus}, {"cpu_model", machine.cpu_model}, {"load_start", loadAverage()}};
+  // Whether the logical CPUs a run on several threads uses were cores of
+  // their own, at the start and at the end (validation/machine.hpp).
+  const int probe_threads = std::min(std::max(2, o.overrides.threads), std::max(machine.cpus, 1));
+  m["machine"] = Json{{"cpus", machine.cpus},
+                      {"cpu_model", machine.cpu_model},
+                      {"load_start", loadAverage()},
+                      {"core_check_threads", probe_threads},
+                      {"core_share_start", coreShare(probe_threads)}};
   m["repeats"] = o.repeat;
   m["threads"] = o.overrides.threads;
   if (o.overrides.steps) m["steps"] = *o.overrides.steps;
@@ -116,6 +124,7 @@ int bench(const BenchOptions& o) {
     stopped = stopped || table.results.back()[BenchEngine::Cairn].status.rfind("stopped", 0) == 0;
   }
   m["machine"]["load_end"] = loadAverage();
+  m["machine"]["core_share_end"] = coreShare(probe_threads);
 
   try {
     writeBenchFiles(o.out, table);

@@ -185,6 +185,15 @@ std::string benchMarkdown(const BenchTable& t) {
         " logical CPUs (`nproc`), " + m["machine"].value("cpu_model", std::string()) + "; load average " +
         m["machine"].value("load_start", std::string()) + " at the start, " +
         m["machine"].value("load_end", std::string()) + " at the end (1, 5, 15 min).\n\n";
+  // The core check (validation/machine.hpp, coreShare): a manifest written
+  // before it existed has none.
+  const int probe = m["machine"].value("core_check_threads", 0);
+  if (probe >= 2)
+    md += "Core check: " + std::to_string(probe) + " threads running a multiply-add loop at once each kept " +
+          g("%.2f", m["machine"].value("core_share_start", 0.0)) + " of one thread's rate at the start, " +
+          g("%.2f", m["machine"].value("core_share_end", 0.0)) +
+          " at the end (about 1 where the logical CPUs are cores of their own; well below, they shared cores with "
+          "other work, and times on more than one thread say little about the engine).\n\n";
   md += "Repeats: " + std::to_string(m.value("repeats", 0)) +
         " per engine configuration, the three taking turns; a time is the median over repeats of a run's mean step "
         "time. Absolute times on a shared machine are noise: read the ratios, measured in the same run. "

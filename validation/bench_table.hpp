@@ -37,7 +37,8 @@
 namespace cairn::validation {
 
 struct BenchTable {
-  // format, command, date, machine {cpus, cpu_model, load_start, load_end},
+  // format, command, date, machine {cpus, cpu_model, load_start, load_end,
+  // core_check_threads, core_share_start, core_share_end},
   // repeats, threads, steps, set, cairn_set, bullet_set, scaling, scenes.
   nlohmann::ordered_json manifest;
   std::vector<BenchScene> scenes;          // as run (the settings columns read them)

@@ -15,6 +15,7 @@
 #include "validation/standard_scenes.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -133,6 +134,22 @@ TEST(BenchCommand, ShortRunOfTwoSmallScenesWritesTheDocumentedTable) {
   // Every documented column is named in docs/benchmarks.md.
   const std::string doc = slurp(std::string(CAIRN_SOURCE_DIR) + "/docs/benchmarks.md");
   for (const std::string& c : documentedColumns()) EXPECT_NE(doc.find("`" + c + "`"), std::string::npos) << c;
+
+  // The core check: each thread's share of one thread's multiply-add rate,
+  // at the start and the end. A share is a ratio of two times of the same
+  // work; above 1 only by timing noise (best of three each, a few percent),
+  // and above 0 unless a thread never ran.
+  const auto manifest = nlohmann::json::parse(slurp(out + "/bench.json"));
+  const auto& machine = manifest.at("machine");
+  EXPECT_EQ(machine.at("core_check_threads").get<int>(), std::min(2, std::max(1, machine.at("cpus").get<int>())));
+  for (const char* k : {"core_share_start", "core_share_end"}) {
+    EXPECT_GT(machine.at(k).get<double>(), 0) << k;
+    EXPECT_LT(machine.at(k).get<double>(), 1.5) << k;
+  }
+  const std::string md = slurp(out + "/bench.md");
+  if (machine.at("cpus").get<int>() >= 2) {
+    EXPECT_NE(md.find("Core check: 2 threads"), std::string::npos);
+  }
 
   for (const Row& row : rows) {
     SCOPED_TRACE(row.at("scene") + " " + row.at("engine"));

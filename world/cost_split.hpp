@@ -41,7 +41,6 @@ class CostSplit {
   int end(int thread) const { return bounds_[static_cast<size_t>(thread) + 1]; }
   // What thread `thread`'s range took.
   void record(int thread, double seconds) { seconds_[static_cast<size_t>(thread)] = seconds; }
-  const std::vector<double>& fractions() const { return fraction_; }
 
  private:
   // New split points at equal shares of the cost, the cost spread evenly

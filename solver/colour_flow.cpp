@@ -42,6 +42,10 @@ ColourFlow& ColourFlow::operator=(const ColourFlow& o) {
   items_ = o.items_;
   need_ = o.need_;
   prev_need_ = o.prev_need_;
+  own_prev_begin_ = o.own_prev_begin_;
+  own_prev_ = o.own_prev_;
+  ran_.assign(o.ran_.size(), 0);
+  tally_.assign(o.tally_.size(), Tally{});
   progress_size_ = o.progress_size_;
   progress_ = progress_size_ > 0 ? std::make_unique<Progress[]>(static_cast<size_t>(progress_size_)) : nullptr;
   return *this;
@@ -139,10 +143,16 @@ void ColourFlow::commit(std::int32_t colour, const std::vector<Run>& runs) {
       free_[t] = s.finish;
       load_[t] += item_work_[static_cast<size_t>(i)];
       sequence_.push_back(s);
+      const auto own_first = static_cast<std::ptrdiff_t>(own_prev_sequence_.size());
       for (const std::int32_t b : bodiesOf(i)) {
         sequence_bodies_.push_back(b);
-        last_at_[static_cast<size_t>(b) * T + t] = s.at;  // a thread's items come in order
+        std::int32_t& last_here = last_at_[static_cast<size_t>(b) * T + t];
+        if (last_here >= 0 && std::find(own_prev_sequence_.begin() + own_first, own_prev_sequence_.end(), last_here) ==
+                                  own_prev_sequence_.end())
+          own_prev_sequence_.push_back(last_here);
+        last_here = s.at;  // a thread's items come in order
       }
+      own_prev_sequence_begin_.push_back(static_cast<std::int32_t>(own_prev_sequence_.size()));
       sequence_body_begin_.push_back(static_cast<std::int32_t>(sequence_bodies_.size()));
     }
   }
@@ -162,6 +172,8 @@ bool ColourFlow::plan(const GraphProblem& p, int threads, int dynamic_end, doubl
   const size_t T = static_cast<size_t>(threads);
   sequence_.clear();
   need_sequence_.clear();
+  own_prev_sequence_.clear();
+  own_prev_sequence_begin_.assign(1, 0);
   count_.assign(T, 0);
   load_.assign(T, 0);
   free_.assign(T, 0);
@@ -225,10 +237,23 @@ bool ColourFlow::plan(const GraphProblem& p, int threads, int dynamic_end, doubl
   items_.resize(sequence_.size());
   need_.resize(need_sequence_.size());
   prev_need_.resize(need_sequence_.size());
+  ran_.assign(sequence_.size() * kMaxOverlappedPasses, 0);
+  tally_.assign(T, Tally{});
+  // The own items before each, gathered in the threads' order.
+  own_prev_begin_.assign(sequence_.size() + 1, 0);
+  for (size_t q = 0; q < sequence_.size(); ++q) {
+    const Planned& s = sequence_[q];
+    own_prev_begin_[static_cast<size_t>(thread_begin_[static_cast<size_t>(s.thread)] + s.at) + 1] =
+        own_prev_sequence_begin_[q + 1] - own_prev_sequence_begin_[q];
+  }
+  for (size_t k = 0; k < sequence_.size(); ++k) own_prev_begin_[k + 1] += own_prev_begin_[k];
+  own_prev_.resize(own_prev_sequence_.size());
   for (size_t q = 0; q < sequence_.size(); ++q) {
     const Planned& s = sequence_[q];
     const size_t k = static_cast<size_t>(thread_begin_[static_cast<size_t>(s.thread)] + s.at);
     items_[k] = s.item;
+    std::copy(own_prev_sequence_.begin() + own_prev_sequence_begin_[q], own_prev_sequence_.begin() + own_prev_sequence_begin_[q + 1],
+              own_prev_.begin() + own_prev_begin_[k]);
     std::copy_n(need_sequence_.begin() + static_cast<std::ptrdiff_t>(q * T), T,
                 need_.begin() + static_cast<std::ptrdiff_t>(k * T));
     // The pass before, for interleaved passes: per thread, its last item

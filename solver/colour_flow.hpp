@@ -24,6 +24,16 @@
 // their predecessors done a colour earlier. In any other order the
 // schedule is as correct, only slower.
 //
+// When a border item still waits, its thread runs the next of its items
+// that is ready instead (up to kLookahead ahead: the next colour's items
+// at the far end of its run share no body with it), and comes back to it.
+// Out-of-order work hides the other thread's lag instead of waiting it
+// out: on the 5,050-box pyramid the solve on two threads went from 10.8
+// to 13.4 ms a step to 8.6 to 11.8 (docs/performance.md, "Now: a look
+// ahead in one island's flow"). It needs what the in-order schedule could
+// leave out: every item of its own thread that touched one of its bodies
+// before it (per body, the last one), not only the latest of them.
+//
 // The plan is made once per (sub)step for the graph built in it, and used
 // by every pass over the colours (warm start, sweeps, momentum, correction)
 // whose items touch the bodies the plan saw.
@@ -54,8 +64,9 @@ inline constexpr int kMaxOverlappedPasses = 3;
 // run (pos[k] is pass k's count of items done); with `wait` it may wait for
 // other threads first, and it is asked so only for the lead, whose passes
 // before are all done. run(j, i) runs pass j's item i. The one-thread
-// pipeline (pass_pipeline.hpp) and each of the flow's threads (below) run
-// their passes through it.
+// pipeline (pass_pipeline.hpp) runs its passes through it; the flow's
+// threads (below) run theirs the same way, with a look ahead in the
+// leading pass.
 template <class Ready, class Run>
 void interleavePasses(int passes, std::int32_t n, Ready&& ready, Run&& run) {
   std::int32_t pos[kMaxOverlappedPasses] = {};
@@ -114,18 +125,25 @@ class ColourFlow {
   // schedule to run.
   bool planned() const { return planned_; }
   bool ready() const { return threads_ > 0; }
+  // Items the last run() or runInterleaved() ran while an item before them
+  // on their thread waited (runThreadInterleaved's look ahead).
+  std::int64_t passedOver() const {
+    std::int64_t n = 0;
+    for (const Tally& t : tally_) n += t.passed_over;
+    return n;
+  }
   void reset() {
     threads_ = 0;
     planned_ = false;
   }
 
   // Runs fn(item) for every item on `pool` (whose thread count the plan
-  // was made for): each thread its own items, each after the other
-  // threads' items it waits for.
+  // was made for): each thread its own items, each after the items, on any
+  // thread, that touched its bodies before it (one pass of
+  // runInterleaved).
   template <class F>
   void run(WorkerPool& pool, F&& fn) {
-    for (int t = 0; t < threads_; ++t) progress_[t].done.store(0, std::memory_order_relaxed);
-    pool.parallelFor(threads_, [&](int t, int) { runThread(t, fn); });
+    runInterleaved(pool, 1, [&](int, const FlowItem& it) { fn(it); });
   }
 
   // Runs fn(j, item) for consecutive passes j = 0 .. passes - 1 over every
@@ -134,12 +152,14 @@ class ColourFlow {
   // pass, a thread runs its later passes' items as far as they are ready.
   // An item of pass j is ready when the items of pass j it waits for in
   // run() are done, and those of pass j - 1 that touch its bodies, on any
-  // thread. Only the first unfinished pass waits; no wait can deadlock: the
-  // earliest unfinished item of the lowest unfinished pass waits for
-  // nothing.
+  // thread. Only the first unfinished pass waits, and it runs any ready
+  // item of the next few instead (runThreadInterleaved); no wait can
+  // deadlock: the earliest unfinished item of the lowest unfinished pass
+  // waits for nothing.
   template <class F>
   void runInterleaved(WorkerPool& pool, int passes, F&& fn) {
     for (int k = 0; k < passes * threads_; ++k) progress_[k].done.store(0, std::memory_order_relaxed);
+    for (Tally& t : tally_) t.passed_over = 0;
     pool.parallelFor(threads_, [&](int t, int) { runThreadInterleaved(t, passes, fn); });
   }
 
@@ -147,21 +167,46 @@ class ColourFlow {
   struct alignas(64) Progress {
     std::atomic<std::int32_t> done{0};  // items of this thread finished in this pass
   };
+  struct alignas(64) Tally {
+    std::int64_t passed_over = 0;  // written by its thread alone, read after the run
+  };
 
-  // Whether thread u has done `count` of its items in pass j; waits for it
-  // if `wait`.
-  bool reached(int j, int u, std::int32_t count, bool wait) const {
-    const std::atomic<std::int32_t>& done = progress_[j * threads_ + u].done;
-    if (wait) return WorkerPool::waitAtLeast(done, count) >= count;
-    return done.load(std::memory_order_acquire) >= count;
+  // Whether thread u has done `count` of its items in pass j.
+  bool reached(int j, int u, std::int32_t count) const {
+    return progress_[j * threads_ + u].done.load(std::memory_order_acquire) >= count;
   }
 
+  // How many of its next items of the leading pass a thread looks over
+  // for one that is ready (runThreadInterleaved).
+  static constexpr std::int32_t kLookahead = 8;
+
+  // Thread t's share of `passes` interleaved passes (one, for run()).
+  // The leading pass (its first unfinished one) runs the first of its next
+  // kLookahead items that is ready, not only the next in order: an item
+  // that waits for the other thread's border item of the colour before is
+  // passed over while the items after it, which share no body with it,
+  // run. Each body still sees its constraints in colour order, one at a
+  // time (an item runs only after the items before it, on any thread, that
+  // touch its bodies), so the bits are those of one thread. What a thread
+  // makes known is the count of its items done without a gap (`pos`): a
+  // thread that waits for one of a passed-over item's followers waits for
+  // it too, which only delays. No wait can deadlock: the earliest
+  // unfinished item, in the plan's order, of the lowest unfinished pass
+  // is ready, and it is the first of its thread's window.
   template <class F>
   void runThreadInterleaved(int t, int passes, F& fn) {
     const std::int32_t first = thread_begin_[static_cast<size_t>(t)];
     const std::int32_t n = thread_begin_[static_cast<size_t>(t) + 1] - first;
-    const auto ready = [&](int j, const std::int32_t* pos, bool wait) {
-      const size_t k = static_cast<size_t>(first + pos[j]) * static_cast<size_t>(threads_);
+    const size_t stride = items_.size();
+    for (int j = 0; j < passes; ++j)
+      std::fill_n(ran_.begin() + static_cast<std::ptrdiff_t>(static_cast<size_t>(j) * stride + static_cast<size_t>(first)), n,
+                  std::uint8_t{0});
+    const auto ran = [&](int j, std::int32_t i) -> std::uint8_t& {
+      return ran_[static_cast<size_t>(j) * stride + static_cast<size_t>(first + i)];
+    };
+    std::int32_t pos[kMaxOverlappedPasses] = {};  // per pass: items done without a gap
+    const auto ready = [&](int j, std::int32_t i) {
+      const size_t k = static_cast<size_t>(first + i) * static_cast<size_t>(threads_);
       for (int u = 0; u < threads_; ++u) {
         const std::int32_t same = need_[k + static_cast<size_t>(u)];
         const std::int32_t before = j > 0 ? prev_need_[k + static_cast<size_t>(u)] : 0;
@@ -169,27 +214,52 @@ class ColourFlow {
           if (j > 0 && before > pos[j - 1]) return false;  // this thread's own pass before
           continue;
         }
-        if (same > 0 && !reached(j, u, same, wait)) return false;
-        if (before > 0 && !reached(j - 1, u, before, wait)) return false;
+        if (same > 0 && !reached(j, u, same)) return false;
+        if (before > 0 && !reached(j - 1, u, before)) return false;
+      }
+      // This thread's items before it that touch its bodies, per body the
+      // last of them: run, or within the count done without a gap.
+      const size_t item = static_cast<size_t>(first + i);
+      for (std::int32_t q = own_prev_begin_[item]; q < own_prev_begin_[item + 1]; ++q) {
+        const std::int32_t own = own_prev_[static_cast<size_t>(q)];
+        if (own >= pos[j] && !ran(j, own)) return false;
       }
       return true;
     };
-    interleavePasses(passes, n, ready, [&](int j, std::int32_t i) {
-      fn(j, items_[static_cast<size_t>(first + i)]);
-      progress_[j * threads_ + t].done.store(i + 1, std::memory_order_release);
-    });
-  }
-
-  template <class F>
-  void runThread(int t, F& fn) {
-    const std::int32_t first = thread_begin_[static_cast<size_t>(t)];
-    const std::int32_t last = thread_begin_[static_cast<size_t>(t) + 1];
-    for (std::int32_t k = first; k < last; ++k) {
-      const std::int32_t* need = need_.data() + static_cast<size_t>(k) * static_cast<size_t>(threads_);
-      for (int u = 0; u < threads_; ++u)
-        if (need[u] > 0) WorkerPool::waitAtLeast(progress_[u].done, need[u]);
-      fn(items_[static_cast<size_t>(k)]);
-      progress_[t].done.store(k - first + 1, std::memory_order_release);
+    const auto publish = [&](int j) {
+      std::int32_t p = pos[j];
+      while (p < n && ran(j, p)) ++p;
+      if (p == pos[j]) return;
+      pos[j] = p;
+      progress_[j * threads_ + t].done.store(p, std::memory_order_release);
+    };
+    int spin = 0;
+    for (int lead = 0; lead < passes;) {
+      if (pos[lead] == n) {
+        ++lead;
+        continue;
+      }
+      bool ran_one = false;
+      const std::int32_t window = std::min(n, pos[lead] + kLookahead);
+      for (std::int32_t i = pos[lead]; i < window && !ran_one; ++i) {
+        if (ran(lead, i) || !ready(lead, i)) continue;
+        fn(lead, items_[static_cast<size_t>(first + i)]);
+        ran(lead, i) = 1;
+        ran_one = true;
+        if (i != pos[lead]) ++tally_[static_cast<size_t>(t)].passed_over;
+      }
+      if (ran_one) {
+        publish(lead);
+        spin = 0;
+      } else {
+        WorkerPool::waitRound(spin++);
+      }
+      for (int j = lead + 1; j < passes; ++j)
+        while (pos[j] < n && ready(j, pos[j])) {
+          fn(j, items_[static_cast<size_t>(first + pos[j])]);
+          ran(j, pos[j]) = 1;
+          publish(j);
+        }
     }
   }
 
@@ -202,7 +272,14 @@ class ColourFlow {
   // passes are interleaved: up to the last of u's items to touch one of
   // its bodies in the whole pass (and on its own thread, itself).
   std::vector<std::int32_t> prev_need_;
+  // Per item, from own_prev_begin_[k] to own_prev_begin_[k + 1]: for each
+  // of its bodies that an item before it on its thread touched, the place
+  // in the thread's order of the last such item (each place once).
+  std::vector<std::int32_t> own_prev_begin_, own_prev_;
+  // Per pass and item: whether it has run (each thread writes its own).
+  std::vector<std::uint8_t> ran_;
   std::unique_ptr<Progress[]> progress_;
+  std::vector<Tally> tally_;  // per thread
   int progress_size_ = 0;
 
   // Planning, with scratch kept so that it allocates nothing once warm.
@@ -230,6 +307,8 @@ class ColourFlow {
 
   std::vector<Planned> sequence_;              // every item, in the order planned
   std::vector<std::int32_t> need_sequence_;    // need_, in that order
+  std::vector<std::int32_t> own_prev_sequence_;  // own_prev_, in that order: sequence_[q]'s from
+  std::vector<std::int32_t> own_prev_sequence_begin_;  // own_prev_sequence_begin_[q]
   std::vector<std::int32_t> count_;            // per thread: items so far
   std::vector<std::int64_t> load_, free_;      // per thread: work so far, and when it is free
   std::vector<std::int32_t> last_;             // per body: the last item (in sequence_) to touch it

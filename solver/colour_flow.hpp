@@ -28,11 +28,12 @@
 // that is ready instead (up to kLookahead ahead: the next colour's items
 // at the far end of its run share no body with it), and comes back to it.
 // Out-of-order work hides the other thread's lag instead of waiting it
-// out: on the 5,050-box pyramid the solve on two threads went from 10.8
-// to 13.4 ms a step to 8.6 to 11.8 (docs/performance.md, "Now: a look
-// ahead in one island's flow"). It needs what the in-order schedule could
-// leave out: every item of its own thread that touched one of its bodies
-// before it (per body, the last one), not only the latest of them.
+// out: on the 5,050-box pyramid it took about 1.5 ms of the 2.5 to 3 ms a
+// step that the waits cost the solve on two threads (docs/performance.md,
+// "Now: a look ahead in one island's flow, ..."). It needs what the
+// in-order schedule could leave out: every item of its own thread that
+// touched one of its bodies before it (per body, the last one), not only
+// the latest of them.
 //
 // The plan is made once per (sub)step for the graph built in it, and used
 // by every pass over the colours (warm start, sweeps, momentum, correction)

@@ -219,7 +219,10 @@ class ColourFlow {
         if (before > 0 && !reached(j - 1, u, before)) return false;
       }
       // This thread's items before it that touch its bodies, per body the
-      // last of them: run, or within the count done without a gap.
+      // last of them: run, or within the count done without a gap (all
+      // of them are for the next item in order, the trailing passes' only
+      // kind).
+      if (i == pos[j]) return true;
       const size_t item = static_cast<size_t>(first + i);
       for (std::int32_t q = own_prev_begin_[item]; q < own_prev_begin_[item + 1]; ++q) {
         const std::int32_t own = own_prev_[static_cast<size_t>(q)];

@@ -21,6 +21,7 @@
 #include "constraints/parts.hpp"
 #include "cairn/defs.hpp"
 
+#include <cstddef>
 #include <cstdint>
 
 namespace cairn {
@@ -38,10 +39,13 @@ struct ContactPointState {
   std::int32_t friction_row = -1;  // first of one or two (SolverSettings::friction_directions)
 };
 
-// The first 48 bytes hold what the step's walks over every contact read:
-// the shapes and bodies, the point count, the flags and the depth after the
-// step. Contacts are 704 bytes (11 cache lines) apart, each starting a
-// line: a walk that reads only these fields touches one line of each.
+// The first 64 bytes hold what the step's walks over every contact read:
+// the shapes and bodies, the point count, the flags, the depth after the
+// step and the rolling and torsional coefficients (which say whether the
+// contact is a row group: the graph's layout and the islands' row counts
+// read them for every contact). Contacts are 704 bytes (11 cache lines)
+// apart, each starting a line: a walk that reads only these fields touches
+// one line of each.
 struct alignas(64) Contact {
   std::int32_t shape_a = -1, shape_b = -1;  // world shape indices, shape_a < shape_b
   std::int32_t triangle = -1;               // mesh triangle, else -1
@@ -53,10 +57,10 @@ struct alignas(64) Contact {
   bool carried = false;                     // this step's copy of last step's manifold (asleep or recycled):
                                             // its impulses are already its own, nothing to match
   Real depth_after = 0;                     // deepest overlap after the last step (the penetration watcher)
+  Real rolling_friction = 0, torsional_friction = 0;
   Vec3 normal = Vec3::UnitY();              // from A to B, world
   ContactPointState points[4];
   Real friction = 0, restitution = 0;
-  Real rolling_friction = 0, torsional_friction = 0;
   Vec3 rolling_impulse = Vec3::Zero();      // world vector, carried
   std::int32_t rolling_row = -1;
   // Where the narrowphase made this manifold, in A's frame (for recycling,
@@ -77,6 +81,7 @@ struct alignas(64) Contact {
     return s;
   }
 };
+static_assert(offsetof(Contact, torsional_friction) + sizeof(Real) <= 64, "the walks' fields leave the first line");
 
 // Asks the cache for a contact's lines ahead of a walk that visits the
 // contacts in another order than they are stored (the solver's lane

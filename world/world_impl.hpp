@@ -126,6 +126,7 @@ struct StepContext {
   std::vector<std::int32_t> lane_contact;  // per batch lane (batch * 8 + lane): contact index, -1 padding
   std::vector<std::int32_t> group_joint;   // per row group: joint index, or -1 - contact index
   std::vector<char> island_pushing;        // per island: some contact deeper than the slop (being pushed out)
+  std::vector<std::int32_t> lane_pushing;  // per batch lane: the island its contact pushes out, else -1
   std::vector<std::vector<Contact>> pair_contacts;  // collide's threads: per thread, the contacts of its pairs
   std::vector<std::vector<Manifold>> pair_manifolds;  // per thread, narrowphase scratch ([0]: the calling thread)
   std::vector<int> pair_recycled;

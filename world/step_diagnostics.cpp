@@ -75,6 +75,7 @@
 #include "collision/aabb.hpp"
 #include "constraints/parts.hpp"
 #include "dynamics/forces.hpp"
+#include "world/body_walk.hpp"
 #include "world/parallel_thresholds.hpp"
 #include "world/step_stages.hpp"
 
@@ -142,20 +143,35 @@ void watchEnergy(WorldImpl& w, StepContext& ctx) {
     for (const Spring& s : w.springs_)
       if (s.alive) scale += springEnergyAt(w, s, nullptr);
   const Real g = w.gravity_.norm();
-  for (size_t i = 0; i < w.bodies_.size(); ++i) {
+  // Each moving dynamic body's T + V now and its share of the energy scale
+  // (what is in motion, and the work to lift each awake body by its radius
+  // of gyration), on the pool's threads (world/body_walk.hpp); summed below
+  // in body order on this thread, from these arrays.
+  const size_t n = w.bodies_.size();
+  ctx.end_energy.resize(n);
+  ctx.energy_scale.resize(n);
+  ctx.energy_counted.resize(n);
+  anyBody(w, [&](size_t i) {
+    const Body& b = w.bodies_[i];
+    const bool counted = ctx.moves(i) && b.alive && b.isDynamic();
+    ctx.energy_counted[i] = counted;
+    if (!counted) return false;
+    const Real kinetic = b.kineticEnergy();
+    ctx.end_energy[i] = kinetic - b.mass * w.gravity_.dot(b.position);
+    ctx.energy_scale[i] = watch && !b.asleep
+                              ? kinetic + b.mass * g * std::sqrt(std::max(Real(0), b.inertia_body.trace() / (2 * b.mass)))
+                              : Real(0);
+    return false;
+  });
+  for (size_t i = 0; i < n; ++i) {
     if (!ctx.moves(i)) {
       still += ctx.start_energy[i];  // 0 for a body that is not dynamic
       continue;
     }
-    const Body& b = w.bodies_[i];
-    if (!b.alive || !b.isDynamic()) continue;
-    const Real kinetic = b.kineticEnergy();
+    if (!ctx.energy_counted[i]) continue;
     before += ctx.start_energy[i];
-    after += kinetic - b.mass * w.gravity_.dot(b.position);
-    // The energy scale: what is in motion, and the work to lift each awake
-    // body by its radius of gyration.
-    if (watch && !b.asleep)
-      scale += kinetic + b.mass * g * std::sqrt(std::max(Real(0), b.inertia_body.trace() / (2 * b.mass)));
+    after += ctx.end_energy[i];
+    scale += ctx.energy_scale[i];  // + 0 for a body asleep or not watched
   }
   for (const Spring& s : w.springs_)
     if (s.alive) {
@@ -351,19 +367,26 @@ Real thinnestShape(const WorldImpl& w) {
 }
 
 void watchFastBodies(WorldImpl& w, StepContext& ctx) {
+  // Cheap test first: a body that moved less than its radius of gyration
+  // cannot have passed anything thinner than itself. Most steps no body
+  // passes it, and it reads every moving body: on the pool's threads
+  // (world/body_walk.hpp), the rest below in body order.
+  const auto fast = [&](size_t i) {
+    if (!ctx.moves(i)) return false;
+    const Body& b = w.bodies_[i];
+    if (!b.alive || !b.isDynamic() || b.asleep || b.ccd || b.shapes.empty()) return false;
+    return (b.position - ctx.step_start[i].x).norm() > Real(0.5) * std::sqrt(b.inertia_body.trace() / (2 * b.mass));
+  };
+  if (!anyBody(w, fast)) return;
   Real thinnest = -1;  // found once per step, and only when a body is fast enough to need it
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
-    if (!ctx.moves(i)) continue;
+    if (!fast(i)) continue;
     const Body& b = w.bodies_[i];
-    if (!b.alive || !b.isDynamic() || b.asleep || b.ccd || b.shapes.empty()) continue;
     // A body whose filter meets no shape's in the world passes through
     // everything by design (a chain whose links collide with nothing).
     if (!w.broadphase_.mayPairWithAny(b.collision_group, b.collision_mask)) continue;
     const Vec3 from = ctx.step_start[i].x, to = b.position;
     const Real travel = (to - from).norm();
-    // Cheap test first: a body that moved less than its radius of gyration
-    // cannot have passed anything thinner than itself.
-    if (!(travel > Real(0.5) * std::sqrt(b.inertia_body.trace() / (2 * b.mass)))) continue;
     Real own = kInf;
     for (const ShapeDesc& s : b.shapes) own = std::min(own, thickness(s));
     if (!(travel > own)) continue;

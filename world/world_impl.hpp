@@ -182,6 +182,11 @@ struct StepContext {
   // body that does not move keeps it to the bit, so the watchers sum it
   // from here instead of reading the body again.
   std::vector<Real> start_energy;
+  // Per body slot, the energy watcher's walk (world/step_diagnostics.cpp):
+  // whether the body is summed at both ends, its T + V after the step, and
+  // its share of the energy scale.
+  std::vector<char> energy_counted;
+  std::vector<Real> end_energy, energy_scale;
   std::vector<char> frozen_island;
   bool any_frozen = false;
   // The contact lanes hold impulses the contact cache does not have yet

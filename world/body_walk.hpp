@@ -1,0 +1,32 @@
+// A walk over every body slot, on the pool's threads when there are enough
+// bodies: the guards' and watchers' per-body work after each stage. Each
+// call writes only its own body's entries; whatever needs the bodies in
+// order (an event, a sum) is done after, on the calling thread, so no
+// result depends on the split.
+#pragma once
+
+#include "world/parallel_thresholds.hpp"
+#include "world/world_impl.hpp"
+
+#include <atomic>
+
+namespace cairn::detail {
+
+// Calls fn(i) for every body slot i; true when some call returned true.
+template <class F>
+bool anyBody(WorldImpl& w, F&& fn) {
+  const int count = static_cast<int>(w.bodies_.size());
+  const auto range = [&](int begin, int end) {
+    bool any = false;
+    for (int i = begin; i < end; ++i) any = fn(static_cast<size_t>(i)) || any;
+    return any;
+  };
+  if (!w.pool_ || count < kParallelBodies) return range(0, count);
+  std::atomic<bool> found{false};
+  w.pool_->parallelFor(count, [&](int begin, int end) {
+    if (range(begin, end)) found.store(true, std::memory_order_relaxed);
+  });
+  return found.load(std::memory_order_relaxed);
+}
+
+}  // namespace cairn::detail

@@ -94,16 +94,28 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
     w.body(sleeper).sleep_timer = 0;
     to_wake.push_back(w.sleep_island_[static_cast<size_t>(sleeper.index)]);
   };
-  if (anything_moves) {
+  // The same walk unites the dynamic bodies each contact and joint joins
+  // (below, the sets of awake ones become the islands): a second walk over
+  // the 700-byte contacts cost the 5,050-box pyramid 0.1 ms a step. Waking
+  // does not change which bodies are dynamic, and the unions come in the
+  // same order, contacts then joints.
+  ctx.uf_parent.resize(static_cast<size_t>(n));
+  for (std::int32_t i = 0; i < n; ++i) ctx.uf_parent[static_cast<size_t>(i)] = i;
+  const auto join = [&](BodyId a, BodyId b) {
+    if (has(a, kDynamic) && has(b, kDynamic)) unite(ctx.uf_parent, a.index, b.index);
+  };
+  if (anything_moves) {  // else no body below is awake: the sets are never read
     for (const Contact& c : w.contacts_) {
       if (!c.enabled) continue;
       touch(c.body_a, c.body_b);
       touch(c.body_b, c.body_a);
+      join(c.body_a, c.body_b);
     }
     for (const Joint& j : w.joints_) {
       if (!j.alive || j.broken) continue;
       touch(j.def.body_a, j.def.body_b);
       touch(j.def.body_b, j.def.body_a);
+      join(j.def.body_a, j.def.body_b);
     }
   }
   if (!to_wake.empty()) {
@@ -118,17 +130,6 @@ void buildIslands(WorldImpl& w, StepContext& ctx) {
       w.sleep_island_[i] = -1;
       flags[i] &= static_cast<std::uint8_t>(~kAsleep);
     }
-  }
-
-  ctx.uf_parent.resize(static_cast<size_t>(n));
-  for (std::int32_t i = 0; i < n; ++i) ctx.uf_parent[static_cast<size_t>(i)] = i;
-  if (anything_moves) {  // else no body below is awake: the sets are never read
-    for (const Contact& c : w.contacts_)
-      if (c.enabled && has(c.body_a, kDynamic) && has(c.body_b, kDynamic))
-        unite(ctx.uf_parent, c.body_a.index, c.body_b.index);
-    for (const Joint& j : w.joints_)
-      if (j.alive && !j.broken && has(j.def.body_a, kDynamic) && has(j.def.body_b, kDynamic))
-        unite(ctx.uf_parent, j.def.body_a.index, j.def.body_b.index);
   }
 
   // Number the islands of awake dynamic bodies in body order. The same

@@ -30,7 +30,7 @@
 // Out-of-order work hides the other thread's lag instead of waiting it
 // out: on the 5,050-box pyramid it took about 1.5 ms of the 2.5 to 3 ms a
 // step that the waits cost the solve on two threads (docs/performance.md,
-// "Now: a look ahead in one island's flow, ..."). It needs what the
+// "Earlier: a look ahead in one island's flow, ..."). It needs what the
 // in-order schedule could leave out: every item of its own thread that
 // touched one of its bodies before it (per body, the last one), not only
 // the latest of them.

@@ -190,7 +190,7 @@ std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>&
 // common paths (a pair at rest, a recycled manifold) stay small: with this
 // inside it, GCC's inlining in collidePair changed with unrelated edits to
 // this file, and collide on one thread with it (11.1 against 11.4 ms a step
-// on the 5,050-box pyramid: docs/performance.md, "Now: what the calling
+// on the 5,050-box pyramid: docs/performance.md, "Earlier: what the calling
 // thread did alone").
 [[gnu::noinline]] void narrowphasePair(const WorldImpl& w, const Body& ba, const Body& bb, const ShapeRef& ra,
                                        const ShapeRef& rb, std::int32_t sa, std::int32_t sb, Real h,

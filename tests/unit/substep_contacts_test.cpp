@@ -1,5 +1,5 @@
 // Contacts over substeps (SolverSettings::prepare_contacts_each_substep,
-// docs/performance.md "Now: contacts over substeps"). Collision runs once
+// docs/performance.md "Earlier: contacts over substeps"). Collision runs once
 // per step, so the constraint graph's layout is made once per step; with
 // the option off, each manifold is also prepared once, and later substeps
 // only measure each point's separation again at the bodies' new poses, as

@@ -179,15 +179,20 @@ TEST(StepDiagnostics, WatchersChangeNothingInTheSimulation) {
   }
 }
 
+// A static wall 1 cm thick across x = 5.
+BodyId addThinWall(World& w) {
+  BodyDef wall = test::boxDef("wall", Vec3(5, 0, 0), 1, Vec3(0.005, 1, 1));
+  wall.type = BodyType::Static;
+  return w.createBody(wall);
+}
+
 // A 5 cm sphere at 100 m/s toward a 1 cm wall, no gravity: 1.67 m a step,
 // far more than the sphere and the wall together; without CCD it passes
 // through and is reported, with CCD it is stopped and is not.
 TEST(StepDiagnostics, FastBodyCrossingAThinShapeWithoutCcdIsReported) {
   for (const bool ccd : {false, true}) {
     World w(Vec3::Zero());
-    BodyDef wall = test::boxDef("wall", Vec3(5, 0, 0), 1, Vec3(0.005, 1, 1));
-    wall.type = BodyType::Static;
-    w.createBody(wall);
+    addThinWall(w);
     BodyDef ball = test::sphereDef("ball", Vec3::Zero(), 1, 0.05);
     ball.linear_velocity = Vec3(100, 0, 0);
     ball.ccd = ccd;
@@ -208,9 +213,7 @@ TEST(StepDiagnostics, WatchersOnThePoolsThreadsReportWhatOneThreadDoes) {
     SolverSettings s;
     s.threads = threads;
     w.setSettings(s);
-    BodyDef wall = test::boxDef("wall", Vec3(5, 0, 0), 1, Vec3(0.005, 1, 1));
-    wall.type = BodyType::Static;
-    w.createBody(wall);
+    addThinWall(w);
     for (int k = 0; k < 1100; ++k) {  // far from the wall and from each other, each drifting its own way
       BodyDef d = test::sphereDef("s" + std::to_string(k), Vec3(Real(k % 33), 20 + Real(k / 33), 0), 1, 0.1);
       d.linear_velocity = Vec3(0, 0, Real(0.01) * (k % 7));
@@ -244,9 +247,7 @@ TEST(StepDiagnostics, WatchersOnThePoolsThreadsReportWhatOneThreadDoes) {
 TEST(StepDiagnostics, FastBodyCrossingAShapeItDoesNotCollideWithIsNotReported) {
   for (const bool jointed : {false, true}) {
     World w(Vec3::Zero());
-    BodyDef wall = test::boxDef("wall", Vec3(5, 0, 0), 1, Vec3(0.005, 1, 1));
-    wall.type = BodyType::Static;
-    const BodyId wall_id = w.createBody(wall);
+    const BodyId wall_id = addThinWall(w);
     BodyDef ball = test::sphereDef("ball", Vec3::Zero(), 1, 0.05);
     ball.linear_velocity = Vec3(100, 0, 0);
     const BodyId id = w.createBody(ball);

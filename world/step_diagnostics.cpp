@@ -375,6 +375,9 @@ void watchFastBodies(WorldImpl& w, StepContext& ctx) {
     if (!ctx.moves(i)) return false;
     const Body& b = w.bodies_[i];
     if (!b.alive || !b.isDynamic() || b.asleep || b.ccd || b.shapes.empty()) return false;
+    // A body whose filter meets no shape's in the world passes through
+    // everything by design (a chain whose links collide with nothing).
+    if (!w.broadphase_.mayPairWithAny(b.collision_group, b.collision_mask)) return false;
     return (b.position - ctx.step_start[i].x).norm() > Real(0.5) * std::sqrt(b.inertia_body.trace() / (2 * b.mass));
   };
   if (!anyBody(w, fast)) return;
@@ -382,9 +385,6 @@ void watchFastBodies(WorldImpl& w, StepContext& ctx) {
   for (size_t i = 0; i < w.bodies_.size(); ++i) {
     if (!fast(i)) continue;
     const Body& b = w.bodies_[i];
-    // A body whose filter meets no shape's in the world passes through
-    // everything by design (a chain whose links collide with nothing).
-    if (!w.broadphase_.mayPairWithAny(b.collision_group, b.collision_mask)) continue;
     const Vec3 from = ctx.step_start[i].x, to = b.position;
     const Real travel = (to - from).norm();
     Real own = kInf;

@@ -29,4 +29,16 @@ bool anyBody(WorldImpl& w, F&& fn) {
   return found.load(std::memory_order_relaxed);
 }
 
+// The guards' and watchers' pattern: test(i) for every body slot (split as
+// above; the test only reads), then, only if some body passed,
+// handle(i) for each that passes test(i) again, in body order on the
+// calling thread (a handle may change what a later test reads: a frozen
+// island's other bodies no longer pass).
+template <class Test, class Handle>
+void handleFound(WorldImpl& w, Test&& test, Handle&& handle) {
+  if (!anyBody(w, test)) return;
+  for (size_t i = 0; i < w.bodies_.size(); ++i)
+    if (test(i)) handle(i);
+}
+
 }  // namespace cairn::detail

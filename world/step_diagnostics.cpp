@@ -380,18 +380,16 @@ void watchFastBodies(WorldImpl& w, StepContext& ctx) {
     if (!w.broadphase_.mayPairWithAny(b.collision_group, b.collision_mask)) return false;
     return (b.position - ctx.step_start[i].x).norm() > Real(0.5) * std::sqrt(b.inertia_body.trace() / (2 * b.mass));
   };
-  if (!anyBody(w, fast)) return;
   Real thinnest = -1;  // found once per step, and only when a body is fast enough to need it
-  for (size_t i = 0; i < w.bodies_.size(); ++i) {
-    if (!fast(i)) continue;
+  handleFound(w, fast, [&](size_t i) {
     const Body& b = w.bodies_[i];
     const Vec3 from = ctx.step_start[i].x, to = b.position;
     const Real travel = (to - from).norm();
     Real own = kInf;
     for (const ShapeDesc& s : b.shapes) own = std::min(own, thickness(s));
-    if (!(travel > own)) continue;
+    if (!(travel > own)) return;
     if (thinnest < 0) thinnest = thinnestShape(w);
-    if (!(travel > own + thinnest)) continue;  // the query below would find nothing
+    if (!(travel > own + thinnest)) return;  // the query below would find nothing
     const Aabb path{from.cwiseMin(to), from.cwiseMax(to)};
     std::int32_t passed = -1;
     Real passed_thickness = 0;
@@ -412,12 +410,12 @@ void watchFastBodies(WorldImpl& w, StepContext& ctx) {
       }
       return true;
     });
-    if (passed < 0) continue;
+    if (passed < 0) return;
     w.diagnose(static_cast<std::int32_t>(i), "fast body without CCD",
                "moved " + fmt(travel) + " m in one step across '" + w.body(passed).name + "' (" +
                    fmt(passed_thickness) + " m thick; the body " + fmt(own) +
                    " m): it can pass through without touching; set ccd on the body or use a smaller dt", true);
-  }
+  });
 }
 
 void watchLimits(WorldImpl& w, StepContext& ctx) {

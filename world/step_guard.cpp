@@ -265,13 +265,11 @@ void guardBodies(WorldImpl& w, StepContext& ctx, const char* stage) {
     const Body& b = w.bodies_[i];
     return b.alive && !b.asleep && b.type != BodyType::Static && !finiteState(b);
   };
-  if (anyBody(w, bad))
-    for (size_t i = 0; i < w.bodies_.size(); ++i) {
-      if (!bad(i)) continue;
-      const std::int32_t isl = ctx.body_island[i];
-      if (isl >= 0 && ctx.frozen_island[static_cast<size_t>(isl)]) continue;  // already stopped: held below
-      freezeIsland(w, ctx, isl, i, stage, badField(w.bodies_[i]));
-    }
+  handleFound(w, bad, [&](size_t i) {
+    const std::int32_t isl = ctx.body_island[i];
+    if (isl >= 0 && ctx.frozen_island[static_cast<size_t>(isl)]) return;  // already stopped: held below
+    freezeIsland(w, ctx, isl, i, stage, badField(w.bodies_[i]));
+  });
   holdFrozen(w, ctx);
 }
 
@@ -282,14 +280,12 @@ void guardSolve(WorldImpl& w, StepContext& ctx) {
     const Body& b = w.bodies_[i];
     return b.alive && !ctx.frozen_island[static_cast<size_t>(isl)] && !finiteState(b);
   };
-  if (anyBody(w, bad))
-    for (size_t i = 0; i < w.bodies_.size(); ++i) {
-      if (!bad(i)) continue;  // frozen_island is read again: a freeze below stops the rest of its island
-      const std::int32_t isl = ctx.body_island[i];
-      const std::string row = badConstraint(w, ctx, isl);
-      if (!row.empty()) freezeIsland(w, ctx, isl, i, "row building", row);
-      else freezeIsland(w, ctx, isl, i, "constraint solve", solveCulprit(w, ctx, isl));
-    }
+  handleFound(w, bad, [&](size_t i) {  // bad() reads frozen_island again: a freeze stops the rest of its island
+    const std::int32_t isl = ctx.body_island[i];
+    const std::string row = badConstraint(w, ctx, isl);
+    if (!row.empty()) freezeIsland(w, ctx, isl, i, "row building", row);
+    else freezeIsland(w, ctx, isl, i, "constraint solve", solveCulprit(w, ctx, isl));
+  });
   holdFrozen(w, ctx);
 }
 

@@ -67,6 +67,18 @@ WorkerPool::~WorkerPool() {
 
 int WorkerPool::currentThread() { return t_thread_index; }
 
+void WorkerPool::keepWarm(bool on) {
+  if (!on) {
+    warm_.store(false, std::memory_order_relaxed);
+    return;
+  }
+  {
+    const std::lock_guard<std::mutex> lock(wake_mutex_);
+    warm_.store(true, std::memory_order_relaxed);
+  }
+  wake_.notify_all();
+}
+
 void WorkerPool::doChunk(const Job& job, int chunk) {
   // Chunk c covers [c n / k, (c + 1) n / k): contiguous and balanced.
   const long n = job.count, k = job.chunks;
@@ -75,6 +87,7 @@ void WorkerPool::doChunk(const Job& job, int chunk) {
 }
 
 void WorkerPool::run(const Job& job) {
+  ++loops_;
   job_ = job;
   // Every worker reports back, busy or not, so none still reads job_ when
   // the next loop overwrites it.
@@ -99,13 +112,20 @@ void WorkerPool::workerLoop(int index) {
   std::uint64_t seen = 0;
   for (;;) {
     std::uint64_t now = generation_.load(std::memory_order_acquire);
-    for (int spin = 0; now == seen && spin < kSpins + kYields; ++spin) {
+    // While warm the rounds go on (their count held at the yields'), else
+    // they end in a sleep.
+    for (int spin = 0; now == seen && (spin < kSpins + kYields || warm_.load(std::memory_order_relaxed));) {
       waitRound(spin);
+      if (spin < kSpins + kYields) ++spin;
       now = generation_.load(std::memory_order_acquire);
     }
     if (now == seen) {
       std::unique_lock<std::mutex> lock(wake_mutex_);
-      wake_.wait(lock, [&] { return generation_.load(std::memory_order_acquire) != seen; });
+      if (generation_.load(std::memory_order_acquire) == seen && !warm_.load(std::memory_order_relaxed))
+        sleeps_.fetch_add(1, std::memory_order_relaxed);
+      wake_.wait(lock, [&] {
+        return generation_.load(std::memory_order_acquire) != seen || warm_.load(std::memory_order_relaxed);
+      });
       continue;
     }
     seen = now;

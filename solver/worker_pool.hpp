@@ -35,6 +35,25 @@ class WorkerPool {
 
   int threads() const { return threads_; }
 
+  // While warm, idle workers keep waiting round after round (a pause, then
+  // a yield of the core) instead of going to sleep, and turning it on
+  // wakes those asleep. The World keeps its pool warm through a step: its
+  // loops come tens of microseconds to milliseconds apart, the spin-then-
+  // sleep wait below outlasts only the shortest gaps, and each loop after
+  // a longer one paid a worker's wake-up (docs/performance.md, "Threads").
+  // Between steps the workers go back to the bounded wait and sleep.
+  void keepWarm(bool on);
+  // Loops handed to the workers since the last call (parallelFor calls
+  // with more than one chunk); starts the count again.
+  std::int64_t takeLoops() {
+    const std::int64_t n = loops_;
+    loops_ = 0;
+    return n;
+  }
+  // How many times a worker has gone to sleep since the pool started (for
+  // tests of keepWarm).
+  std::int64_t sleeps() const { return sleeps_.load(std::memory_order_relaxed); }
+
   // Waits inside the pool's loops (on any of its threads) whose yield gave
   // the core to another task for longer than kPreemptedYield: the pool's
   // threads share their cores with other work. Each loop's threads hand
@@ -100,13 +119,16 @@ class WorkerPool {
   std::vector<std::thread> workers_;
   Job job_;
   // A new job bumps generation_; idle workers spin, yield, then sleep on
-  // wake_, whose mutex orders the bump against a worker's last look before
-  // sleeping, so no job is missed.
+  // wake_ (unless warm_), whose mutex orders the bump and warm_ against a
+  // worker's last look before sleeping, so no job is missed.
   std::atomic<std::uint64_t> generation_{0};
   std::mutex wake_mutex_;
   std::condition_variable wake_;
   std::atomic<int> remaining_{0};
   std::atomic<bool> stop_{false};
+  std::atomic<bool> warm_{false};
+  std::atomic<std::int64_t> sleeps_{0};
+  std::int64_t loops_ = 0;  // the calling thread's own count
   std::atomic<std::int64_t> preempted_{0};
   static inline std::atomic<bool> simulated_lost_cores_{false};
 };

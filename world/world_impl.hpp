@@ -404,6 +404,11 @@ class WorldImpl {
   // with other work (world/pool_watch.hpp: for how many steps).
   std::unique_ptr<WorkerPool> parked_pool_;
   PoolWatch pool_watch_;
+  // Whether the last step handed the pool a loop: only then is the pool
+  // kept warm through the next (world/world_step.cpp), so a scene too
+  // small to split (a lone body, a chain, an asleep pile) does not wake
+  // a worker each step for nothing.
+  bool warm_pool_ = false;
   // false: the pool is never set aside (the tests that must run every step
   // on their threads, whatever else the machine runs).
   bool watch_pool_ = true;

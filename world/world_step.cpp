@@ -99,6 +99,26 @@ void watchPool(WorldImpl& w) {
   if (w.pool_watch_.endPoolStep(w.watch_pool_ ? preempted : 0)) w.parked_pool_ = std::move(w.pool_);
 }
 
+// Keeps the pool's workers waiting warm through the step (solver/worker_pool.hpp)
+// when the last step handed it a loop, and lets them sleep after it,
+// however the step ends.
+class WarmPool {
+ public:
+  explicit WarmPool(WorldImpl& w) : w_(w) {
+    if (w_.pool_ && w_.warm_pool_) w_.pool_->keepWarm(true);
+  }
+  ~WarmPool() {
+    for (WorkerPool* p : {w_.pool_.get(), w_.parked_pool_.get()})
+      if (p) p->keepWarm(false);
+    w_.warm_pool_ = w_.pool_ && w_.pool_->takeLoops() > 0;
+  }
+  WarmPool(const WarmPool&) = delete;
+  WarmPool& operator=(const WarmPool&) = delete;
+
+ private:
+  WorldImpl& w_;
+};
+
 }  // namespace
 
 void WorldImpl::step(Real h) {
@@ -112,6 +132,7 @@ void WorldImpl::step(Real h) {
   ctx.h = h;
   ctx.hs = h / n;
   fitPool(*this);
+  const WarmPool warm(*this);
   saveStepStart(*this, ctx);
   break_events_.clear();
   contact_events_.clear();

@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <thread>
 
 namespace cairn {
 namespace {
@@ -34,6 +35,39 @@ TEST(WorkerPool, AWaitForAThreadOnTheSameCoreIsCountedAsPreempted) {
   });
   EXPECT_GT(pool.takePreemptedWaits(), 0);
   EXPECT_EQ(pool.takePreemptedWaits(), 0);  // taken: counted from zero again
+}
+
+// A pool kept warm (as a World keeps its own through a step) never lets a
+// worker sleep however long the calling thread works alone between loops,
+// and every loop still runs each chunk once; once it is let go, the
+// workers go back to sleep and a later loop still wakes them.
+TEST(WorkerPool, AWarmPoolsWorkersWaitAwakeBetweenLoopsAndSleepOnceLetGo) {
+  WorkerPool pool(2);
+  const auto runLoop = [&] {
+    std::atomic<int> items{0};
+    pool.parallelFor(64, [&](int begin, int end) { items.fetch_add(end - begin); });
+    EXPECT_EQ(items.load(), 64);
+  };
+  const auto sleepsWithin = [&](std::int64_t above, std::chrono::milliseconds limit) {
+    const auto until = std::chrono::steady_clock::now() + limit;
+    while (pool.sleeps() <= above && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return pool.sleeps() > above;
+  };
+  // Unwarmed, an idle worker sleeps after its bounded wait (well under a
+  // second even when each of its yields hands the core away for a slice).
+  runLoop();
+  ASSERT_TRUE(sleepsWithin(0, std::chrono::seconds(10)));
+  pool.keepWarm(true);  // wakes the sleeper
+  const std::int64_t before = pool.sleeps();
+  for (int k = 0; k < 5; ++k) {
+    runLoop();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the caller alone, far past the bounded wait
+  }
+  EXPECT_EQ(pool.sleeps(), before);
+  pool.keepWarm(false);
+  EXPECT_TRUE(sleepsWithin(before, std::chrono::seconds(10)));
+  runLoop();
 }
 
 }  // namespace

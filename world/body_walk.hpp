@@ -12,6 +12,15 @@
 
 namespace cairn::detail {
 
+// Whether a walk over every body slot is worth the pool's threads: the
+// bodies that were awake at the last islands stage (an asleep body is a
+// test and a skip in most walks, and an asleep pile-1000's walks, split,
+// were slower than on one thread). Only the split depends on it, never a
+// result.
+inline bool splitBodyWalk(const WorldImpl& w) {
+  return w.pool_ && static_cast<int>(w.bodies_.size()) - w.ctx_.asleep_bodies >= kParallelBodies;
+}
+
 // Calls fn(i) for every body slot i; true when some call returned true.
 template <class F>
 bool anyBody(WorldImpl& w, F&& fn) {
@@ -21,7 +30,7 @@ bool anyBody(WorldImpl& w, F&& fn) {
     for (int i = begin; i < end; ++i) any = fn(static_cast<size_t>(i)) || any;
     return any;
   };
-  if (!w.pool_ || count < kParallelBodies) return range(0, count);
+  if (!splitBodyWalk(w)) return range(0, count);
   std::atomic<bool> found{false};
   w.pool_->parallelFor(count, [&](int begin, int end) {
     if (range(begin, end)) found.store(true, std::memory_order_relaxed);

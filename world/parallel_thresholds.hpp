@@ -1,6 +1,7 @@
 // Work below which a stage stays on the calling thread when the World has
-// a worker pool (SolverSettings::threads > 1). Handing a loop over wakes a
-// worker that may have slept since the last solve and ends at a barrier;
+// a worker pool (SolverSettings::threads > 1). Handing a loop over costs a
+// write the waiting workers see and a barrier at its end (the pool is kept
+// warm through a step, so no worker has to be woken);
 // each threshold is where that began to pay on the shared 2-core machine,
 // measured as its comment says. The solve's colours have their own rule
 // (solver/graph_solver.cpp). Results never depend on them: the threads
@@ -16,12 +17,16 @@ namespace cairn::detail {
 // then the warm-start matching of new contacts) stays on the calling
 // thread. A fresh narrowphase call is 0.2 to 2 us, but a resting pair is
 // recycled or kept for a tenth of that, and the second thread's contacts
-// are then copied into the list (704 bytes each) after a worker that may
-// have gone to sleep since the last step's solve was woken: with 64, an
-// awake pyramid-20 (590 pairs, most recycled) collided in 0.056 ms on two
+// are then copied into the list (704 bytes each): with 64, an awake
+// pyramid-20 (590 pairs, most recycled) collided in 0.056 ms on two
 // threads against 0.038 on one, while the 5,050-box pyramid (15,000
-// pairs) went from 13.9 to 9.2 ms.
-constexpr int kParallelPairs = 1024;
+// pairs) went from 13.9 to 9.2 ms. Since the World keeps its pool warm
+// through a step (solver/worker_pool.hpp, keepWarm), a handover no longer
+// waits for a worker's wake-up: at 512, pile-1000's awake steps (1,000
+// pairs, recycled) collided in 0.28 ms against 0.35 at 1,024, and
+// pyramid-20's awake collide was unchanged (0.156 to 0.163 ms against
+// 0.157 to 0.164; docs/performance.md, "Now: a warm pool").
+constexpr int kParallelPairs = 512;
 
 // Moved proxies below which the broadphase's pair queries (one tree
 // descent each, about a microsecond on a 5,000-box tree) stay on the
@@ -52,16 +57,20 @@ constexpr int kParallelContacts = 4096;
 // Shapes below which their proxies are refitted on the calling thread
 // (world/world_proxies.cpp). A refit that keeps its fat box is a shape's
 // box and a test, about a tenth of a microsecond (the 5,050-box pyramid's
-// refit took 0.70 ms a step on one thread): a thousand of them are worth
-// waking a worker for, as the pairs are.
-constexpr int kParallelProxies = 1024;
+// refit took 0.70 ms a step on one thread): with the pool kept warm, half
+// a thousand of them are worth handing over, as the pairs are.
+constexpr int kParallelProxies = 512;
 
-// Bodies below which the velocity and position updates stay on the calling
-// thread (world/step_integrate.cpp): 40 to 50 ns a body on the 5,050-box
-// pyramid, 0.45 ms a step for both on one thread. The guards' and
-// watchers' walks over the bodies (world/body_walk.hpp), a few to a few
-// tens of nanoseconds a body each, share it.
-constexpr int kParallelBodies = 1024;
+// Awake bodies below which the velocity and position updates stay on the
+// calling thread (world/step_integrate.cpp): 40 to 50 ns a body on the
+// 5,050-box pyramid, 0.45 ms a step for both on one thread. The guards'
+// and watchers' walks over the bodies (world/body_walk.hpp), a few to a
+// few tens of nanoseconds a body each, share it. The bodies awake at the
+// last islands stage are what is counted (an asleep body is a test and a
+// skip): with every body slot counted at 512, an asleep pile-1000's step
+// was 6% slower on two threads, with the awake ones it is not; its awake
+// steps integrate in 0.049 to 0.054 ms against 0.067 to 0.068 at 1,024.
+constexpr int kParallelBodies = 512;
 
 // Constraints (manifolds and joints) below which the PGS islands are not
 // split into parts, one per thread (world/step_prepare.cpp): a part's

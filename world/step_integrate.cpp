@@ -5,6 +5,7 @@
 // bodies out of penetration without adding momentum).
 #include "dynamics/forces.hpp"
 #include "dynamics/integrate.hpp"
+#include "world/body_walk.hpp"
 #include "world/parallel_thresholds.hpp"
 #include "world/step_stages.hpp"
 
@@ -27,7 +28,7 @@ void forBodies(WorldImpl& w, F&& fn) {
   const auto range = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) fn(static_cast<size_t>(i));
   };
-  if (w.pool_ && count >= kParallelBodies) w.pool_->parallelFor(count, range);
+  if (splitBodyWalk(w)) w.pool_->parallelFor(count, range);
   else range(0, count);
 }
 

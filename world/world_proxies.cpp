@@ -68,10 +68,13 @@ namespace {
 // Refits the proxies of the slots for which `take(slot)` holds: on the
 // pool's threads when there are many, each keeping the slots whose proxies
 // change (a slot's fit is its own), then those changes in slot order.
+// "Many" counts the shapes less one per body asleep at the last islands
+// stage (an asleep body's shapes are a test and a skip; most bodies have
+// one shape): only the split depends on it.
 template <class Take>
 void refitProxies(WorldImpl& w, StepContext& ctx, Real h, Take&& take) {
   const int count = static_cast<int>(w.shapes_.size());
-  if (!w.pool_ || count < kParallelProxies) {
+  if (!w.pool_ || count - ctx.asleep_bodies < kParallelProxies) {
     for (size_t slot = 0; slot < w.shapes_.size(); ++slot)
       if (take(slot)) w.refitProxy(slot, h);
     return;

@@ -37,11 +37,12 @@ class WorkerPool {
 
   // While warm, idle workers keep waiting round after round (a pause, then
   // a yield of the core) instead of going to sleep, and turning it on
-  // wakes those asleep. The World keeps its pool warm through a step: its
-  // loops come tens of microseconds to milliseconds apart, the spin-then-
-  // sleep wait below outlasts only the shortest gaps, and each loop after
-  // a longer one paid a worker's wake-up (docs/performance.md, "Threads").
-  // Between steps the workers go back to the bounded wait and sleep.
+  // wakes those asleep. The World keeps its pool warm through a step that
+  // follows one with a loop handed over: a step's loops come tens of
+  // microseconds to milliseconds apart, the spin-then-sleep wait below
+  // outlasts only the shortest gaps, and each loop after a longer one paid
+  // a worker's wake-up (docs/performance.md, "Now: a warm pool"). Between
+  // steps the workers go back to the bounded wait and sleep.
   void keepWarm(bool on);
   // Loops handed to the workers since the last call (parallelFor calls
   // with more than one chunk); starts the count again.

@@ -108,9 +108,15 @@ class WarmPool {
     if (w_.pool_ && w_.warm_pool_) w_.pool_->keepWarm(true);
   }
   ~WarmPool() {
-    for (WorkerPool* p : {w_.pool_.get(), w_.parked_pool_.get()})
-      if (p) p->keepWarm(false);
-    w_.warm_pool_ = w_.pool_ && w_.pool_->takeLoops() > 0;
+    // Both pools' counts start again (a pool set aside this step must not
+    // bring this step's loops back with it), the active one's decides.
+    w_.warm_pool_ = false;
+    for (WorkerPool* p : {w_.pool_.get(), w_.parked_pool_.get()}) {
+      if (!p) continue;
+      p->keepWarm(false);
+      const bool handed = p->takeLoops() > 0;
+      if (p == w_.pool_.get()) w_.warm_pool_ = handed;
+    }
   }
   WarmPool(const WarmPool&) = delete;
   WarmPool& operator=(const WarmPool&) = delete;

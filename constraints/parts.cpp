@@ -33,6 +33,61 @@ void speculate(ConstraintRow& r, Real target) {
   if (r.correction != Correction::InRhs) r.bias_rhs = target;
 }
 
+
+// addRow's body, inlined where a part makes several rows at once (the
+// point part's three): the Jacobians stay in registers instead of being
+// stored for a call, and the unit axes' ones and zeros are known.
+inline __attribute__((always_inline)) int appendRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot,
+                                                    const Vec3& lin_a, const Vec3& ang_a, const Vec3& lin_b,
+                                                    const Vec3& ang_b, Real c, const Softness* axis_softness, Real lo,
+                                                    Real hi) {
+  // M^-1 J^T and the diagonal from locals; the row is written once (no
+  // read back of what was just stored).
+  const Vec3 m_lin_a = a.inv_mass * a.lin_factor.cwiseProduct(lin_a);
+  const Vec3 m_ang_a = a.inv_inertia * ang_a;
+  const Vec3 m_lin_b = b.inv_mass * b.lin_factor.cwiseProduct(lin_b);
+  const Vec3 m_ang_b = b.inv_inertia * ang_b;
+  const Real diag = lin_a.dot(m_lin_a) + ang_a.dot(m_ang_a) + lin_b.dot(m_lin_b) + ang_b.dot(m_ang_b);
+  if (!(diag > Real(1e-300))) return -1;  // neither body can move along this row
+  // Most rows keep the global ERP and CFM: the softness is resolved (a
+  // call, and a division for the effective mass) only where it is set.
+  const bool own_softness = (axis_softness && axis_softness->isSet()) || ctx.joint_softness->isSet();
+  const ErpCfm soft = own_softness ? resolveSoftness(axis_softness, *ctx.joint_softness, ctx.erp, ctx.cfm, 1 / diag, ctx.h)
+                                   : ErpCfm{ctx.erp, ctx.cfm};
+  const Real cfm = soft.cfm / ctx.h;  // ODE's CFM multiplies a force; lambda is an impulse
+  const bool separate = ctx.correction != Correction::InRhs && !own_softness;
+  const Real bias = correctionBias(ctx, soft, c, lin_a, lin_b);
+  const Real lambda = ctx.warm && slot < static_cast<int>(ctx.warm->size())
+                          ? std::clamp(ctx.warm_factor * (*ctx.warm)[slot], lo, hi)
+                          : Real(0);
+  // Every member named: value-initialising the row first (then writing
+  // it) cleared its ~300 bytes with a string store a row.
+  ctx.rows->push_back(ConstraintRow{.body_a = a.solver_index,
+                                    .body_b = b.solver_index,
+                                    .j_lin_a = lin_a,
+                                    .j_ang_a = ang_a,
+                                    .j_lin_b = lin_b,
+                                    .j_ang_b = ang_b,
+                                    .m_lin_a = m_lin_a,
+                                    .m_ang_a = m_ang_a,
+                                    .m_lin_b = m_lin_b,
+                                    .m_ang_b = m_ang_b,
+                                    .inv_diag = 1 / (diag + cfm),
+                                    .rhs = separate ? Real(0) : bias,
+                                    .cfm = cfm,
+                                    .lo = lo,
+                                    .hi = hi,
+                                    .lambda = lambda,
+                                    .mu = 0,
+                                    .normal_row = -1,
+                                    .kind = ctx.kind,
+                                    .owner = ctx.owner,
+                                    .owner_row = static_cast<std::int8_t>(slot),
+                                    .bias_rhs = separate ? bias : Real(0),
+                                    .correction = separate ? ctx.correction : Correction::InRhs});
+  return static_cast<int>(ctx.rows->size() - 1);
+}
+
 }  // namespace
 
 RowJacobian relativeRotation(const Vec3& u) {
@@ -78,48 +133,7 @@ Real angleNearLimits(Real s, const LimitDef& l) {
 
 int addRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot, const Vec3& lin_a, const Vec3& ang_a,
            const Vec3& lin_b, const Vec3& ang_b, Real c, const Softness* axis_softness, Real lo, Real hi) {
-  // M^-1 J^T and the diagonal from locals; the row is written once (no
-  // read back of what was just stored).
-  const Vec3 m_lin_a = a.inv_mass * a.lin_factor.cwiseProduct(lin_a);
-  const Vec3 m_ang_a = a.inv_inertia * ang_a;
-  const Vec3 m_lin_b = b.inv_mass * b.lin_factor.cwiseProduct(lin_b);
-  const Vec3 m_ang_b = b.inv_inertia * ang_b;
-  const Real diag = lin_a.dot(m_lin_a) + ang_a.dot(m_ang_a) + lin_b.dot(m_lin_b) + ang_b.dot(m_ang_b);
-  if (!(diag > Real(1e-300))) return -1;  // neither body can move along this row
-  const ErpCfm soft = resolveSoftness(axis_softness, *ctx.joint_softness, ctx.erp, ctx.cfm, 1 / diag, ctx.h);
-  const Real cfm = soft.cfm / ctx.h;  // ODE's CFM multiplies a force; lambda is an impulse
-  const bool own_softness = (axis_softness && axis_softness->isSet()) || ctx.joint_softness->isSet();
-  const bool separate = ctx.correction != Correction::InRhs && !own_softness;
-  const Real bias = correctionBias(ctx, soft, c, lin_a, lin_b);
-  const Real lambda = ctx.warm && slot < static_cast<int>(ctx.warm->size())
-                          ? std::clamp(ctx.warm_factor * (*ctx.warm)[slot], lo, hi)
-                          : Real(0);
-  // Every member named: value-initialising the row first (then writing
-  // it) cleared its ~300 bytes with a string store a row.
-  ctx.rows->push_back(ConstraintRow{.body_a = a.solver_index,
-                                    .body_b = b.solver_index,
-                                    .j_lin_a = lin_a,
-                                    .j_ang_a = ang_a,
-                                    .j_lin_b = lin_b,
-                                    .j_ang_b = ang_b,
-                                    .m_lin_a = m_lin_a,
-                                    .m_ang_a = m_ang_a,
-                                    .m_lin_b = m_lin_b,
-                                    .m_ang_b = m_ang_b,
-                                    .inv_diag = 1 / (diag + cfm),
-                                    .rhs = separate ? Real(0) : bias,
-                                    .cfm = cfm,
-                                    .lo = lo,
-                                    .hi = hi,
-                                    .lambda = lambda,
-                                    .mu = 0,
-                                    .normal_row = -1,
-                                    .kind = ctx.kind,
-                                    .owner = ctx.owner,
-                                    .owner_row = static_cast<std::int8_t>(slot),
-                                    .bias_rhs = separate ? bias : Real(0),
-                                    .correction = separate ? ctx.correction : Correction::InRhs});
-  return static_cast<int>(ctx.rows->size() - 1);
+  return appendRow(ctx, a, b, slot, lin_a, ang_a, lin_b, ang_b, c, axis_softness, lo, hi);
 }
 
 void addPointPart(RowContext& ctx, const BodyView& a, const BodyView& b, int first_slot, const Vec3& p_a,
@@ -129,7 +143,7 @@ void addPointPart(RowContext& ctx, const BodyView& a, const BodyView& b, int fir
   ctx.shared_error_norm = err.norm();  // the cap scales the three rows together
   for (int k = 0; k < 3; ++k) {
     const Vec3 n = Vec3::Unit(k);
-    addRow(ctx, a, b, first_slot + k, -n, -ra.cross(n), n, rb.cross(n), err[k]);
+    appendRow(ctx, a, b, first_slot + k, -n, -ra.cross(n), n, rb.cross(n), err[k], nullptr, -kInf, kInf);
   }
   ctx.shared_error_norm = 0;
 }

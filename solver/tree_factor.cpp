@@ -274,26 +274,33 @@ bool TreeFactor::eliminate(const Group& g, std::span<const ConstraintRow> rows, 
     }
   }
 
-  for (std::int32_t s = g.next_begin; s < g.next_end; ++s) {
-    const Group& k = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(s)])];
-    const Shared& sh = shared_[static_cast<std::size_t>(s)];
+  // L_kg = A_kg L_gg^-T for each later neighbour k; a neighbour of the
+  // group's own size (a chain of like joints) with its loops unrolled.
+  const auto below = [&]<int K>(const Group& k, const Shared& sh, double* b) {
+    const int mk = K > 0 ? K : k.size;
     // k's J for the shared body (k's own elimination gathers its rows
     // again with the rest).
     double jk[6 * kMaxGroupRows];
-    gatherSlot<0, false>(rows, subset, pos_.data() + k.rows, k.size, k.body[sh.slot_k], jk, nullptr);
+    gatherSlot<K, false>(rows, subset, pos_.data() + k.rows, mk, k.body[sh.slot_k], jk, nullptr);
     const double* mg = base + sh.slot_g * 12 * m + 6 * m;
-    double* b = values_.data() + below_[static_cast<std::size_t>(s)];
-    for (int r = 0; r < k.size; ++r)
+    for (int r = 0; r < mk; ++r)
       for (int j = 0; j < m; ++j) {
         double v = b[r * m + j] + dot6(jk + 6 * r, mg + 6 * j);
         for (int c = 0; c < j; ++c) v -= b[r * m + c] * l[j * m + c];
         b[r * m + j] = v * inv[j];
       }
+  };
+  for (std::int32_t s = g.next_begin; s < g.next_end; ++s) {
+    const Group& k = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(s)])];
+    const Shared& sh = shared_[static_cast<std::size_t>(s)];
+    double* b = values_.data() + below_[static_cast<std::size_t>(s)];
+    if (M > 0 && k.size == M) below.template operator()<M>(k, sh, b);
+    else below.template operator()<0>(k, sh, b);
   }
-  for (std::int32_t u = g.update_begin; u < g.update_end; ++u) {
-    const Update& up = update_[static_cast<std::size_t>(u)];
-    const std::int32_t mk = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(up.k)])].size;
-    const std::int32_t mi = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(up.i)])].size;
+  // The Schur updates A_ki -= L_kg L_ig^T, unrolled where both neighbours
+  // are of the group's size.
+  const auto update = [&]<int K>(const Update& up, int mk, int mi) {
+    if constexpr (K > 0) mk = mi = K;
     const double* bk = values_.data() + below_[static_cast<std::size_t>(up.k)];
     const double* bi = values_.data() + below_[static_cast<std::size_t>(up.i)];
     double* t = values_.data() + up.target;
@@ -303,6 +310,13 @@ bool TreeFactor::eliminate(const Group& g, std::span<const ConstraintRow> rows, 
         for (int j = 0; j < m; ++j) v += bk[r * m + j] * bi[c * m + j];
         t[r * mi + c] -= v;
       }
+  };
+  for (std::int32_t u = g.update_begin; u < g.update_end; ++u) {
+    const Update& up = update_[static_cast<std::size_t>(u)];
+    const std::int32_t mk = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(up.k)])].size;
+    const std::int32_t mi = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(up.i)])].size;
+    if (M > 0 && mk == M && mi == M) update.template operator()<M>(up, mk, mi);
+    else update.template operator()<0>(up, mk, mi);
   }
   return true;
 }
@@ -329,55 +343,78 @@ bool TreeFactor::factorize(std::span<const ConstraintRow> rows, std::span<const 
   return true;
 }
 
+template <int M>
+void TreeFactor::forwardGroup(const Group& g, double* w) const {
+  const std::int32_t m = M > 0 ? M : g.size;
+  const double* l = values_.data() + g.diag;
+  const double* inv = recip_.data() + g.rows;
+  double* y = w + g.rows;
+  for (std::int32_t j = 0; j < m; ++j) {
+    double v = y[j];
+    for (std::int32_t k = 0; k < j; ++k) v -= l[j * m + k] * y[k];
+    y[j] = v * inv[j];
+  }
+  for (std::int32_t s = g.next_begin; s < g.next_end; ++s) {
+    const Group& k = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(s)])];
+    const double* b = values_.data() + below_[static_cast<std::size_t>(s)];
+    double* yk = w + k.rows;
+    for (std::int32_t r = 0; r < k.size; ++r) {
+      double v = 0;
+      for (std::int32_t j = 0; j < m; ++j) v += b[r * m + j] * y[j];
+      yk[r] -= v;
+    }
+  }
+}
+
+template <int M>
+void TreeFactor::backwardGroup(const Group& g, double* w) const {
+  const std::int32_t m = M > 0 ? M : g.size;
+  const double* l = values_.data() + g.diag;
+  const double* inv = recip_.data() + g.rows;
+  double* y = w + g.rows;
+  for (std::int32_t s = g.next_begin; s < g.next_end; ++s) {
+    const Group& k = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(s)])];
+    const double* b = values_.data() + below_[static_cast<std::size_t>(s)];
+    const double* xk = w + k.rows;
+    for (std::int32_t j = 0; j < m; ++j) {
+      double v = 0;
+      for (std::int32_t r = 0; r < k.size; ++r) v += b[r * m + j] * xk[r];
+      y[j] -= v;
+    }
+  }
+  for (std::int32_t j = m - 1; j >= 0; --j) {
+    double v = y[j];
+    for (std::int32_t k = j + 1; k < m; ++k) v -= l[k * m + j] * y[k];
+    y[j] = v * inv[j];
+  }
+}
+
+// The group sizes the joints make most (a ball 3, a hinge 5, a fixed
+// joint 6) with their loops unrolled, as factorize's eliminate; the
+// arithmetic, and its order, is the same for every size.
+#define CAIRN_TREE_BY_SIZE(call)       \
+  switch (g.size) {                   \
+    case 1: call<1>(g, w); break;     \
+    case 2: call<2>(g, w); break;     \
+    case 3: call<3>(g, w); break;     \
+    case 5: call<5>(g, w); break;     \
+    case 6: call<6>(g, w); break;     \
+    default: call<0>(g, w); break;    \
+  }
+
 void TreeFactor::solveInPlace(std::span<double> x) const {
   double* w = work_.data();
   for (std::size_t k = 0; k < pos_.size(); ++k) w[k] = x[static_cast<std::size_t>(pos_[k])];
   // L y = x, group after group.
-  for (const Group& g : groups_) {
-    const std::int32_t m = g.size;
-    const double* l = values_.data() + g.diag;
-    const double* inv = recip_.data() + g.rows;
-    double* y = w + g.rows;
-    for (std::int32_t j = 0; j < m; ++j) {
-      double v = y[j];
-      for (std::int32_t k = 0; k < j; ++k) v -= l[j * m + k] * y[k];
-      y[j] = v * inv[j];
-    }
-    for (std::int32_t s = g.next_begin; s < g.next_end; ++s) {
-      const Group& k = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(s)])];
-      const double* b = values_.data() + below_[static_cast<std::size_t>(s)];
-      double* yk = w + k.rows;
-      for (std::int32_t r = 0; r < k.size; ++r) {
-        double v = 0;
-        for (std::int32_t j = 0; j < m; ++j) v += b[r * m + j] * y[j];
-        yk[r] -= v;
-      }
-    }
-  }
+  for (const Group& g : groups_) CAIRN_TREE_BY_SIZE(forwardGroup)
   // L^T x = y, in reverse.
   for (auto it = groups_.rbegin(); it != groups_.rend(); ++it) {
     const Group& g = *it;
-    const std::int32_t m = g.size;
-    const double* l = values_.data() + g.diag;
-    const double* inv = recip_.data() + g.rows;
-    double* y = w + g.rows;
-    for (std::int32_t s = g.next_begin; s < g.next_end; ++s) {
-      const Group& k = groups_[static_cast<std::size_t>(next_[static_cast<std::size_t>(s)])];
-      const double* b = values_.data() + below_[static_cast<std::size_t>(s)];
-      const double* xk = w + k.rows;
-      for (std::int32_t j = 0; j < m; ++j) {
-        double v = 0;
-        for (std::int32_t r = 0; r < k.size; ++r) v += b[r * m + j] * xk[r];
-        y[j] -= v;
-      }
-    }
-    for (std::int32_t j = m - 1; j >= 0; --j) {
-      double v = y[j];
-      for (std::int32_t k = j + 1; k < m; ++k) v -= l[k * m + j] * y[k];
-      y[j] = v * inv[j];
-    }
+    CAIRN_TREE_BY_SIZE(backwardGroup)
   }
   for (std::size_t k = 0; k < pos_.size(); ++k) x[static_cast<std::size_t>(pos_[k])] = w[k];
 }
+
+#undef CAIRN_TREE_BY_SIZE
 
 }  // namespace cairn

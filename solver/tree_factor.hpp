@@ -75,6 +75,12 @@ class TreeFactor {
   // The most rows one pair of bodies may carry (a six-dof joint with every
   // limit and motor has twelve); past it CHOLMOD takes the island.
   static constexpr int kMaxGroupRows = 24;
+  // One group's part of the forward (L y = x) and backward (L^T x = y)
+  // substitutions, on the right-hand side in group order.
+  template <int M>
+  void forwardGroup(const Group& g, double* w) const;
+  template <int M>
+  void backwardGroup(const Group& g, double* w) const;
   template <int M>
   bool eliminate(const Group& g, std::span<const ConstraintRow> rows, std::span<const int> subset, double shift,
                  double& lo, double& hi);

@@ -41,8 +41,8 @@ struct BodyView {
 };
 
 // World-frame points and vectors fixed in a body, at its current pose.
-inline Vec3 worldPoint(const BodyView& v, const Vec3& local) { return v.x + v.q * local; }
-inline Vec3 worldVector(const BodyView& v, const Vec3& local) { return v.q * local; }
+inline Vec3 worldPoint(const BodyView& v, const Vec3& local) { return rotateAdd(v.x, v.q, local); }
+inline Vec3 worldVector(const BodyView& v, const Vec3& local) { return rotate(v.q, local); }
 
 // The rate of a joint coordinate: lin_a.v_a + ang_a.w_a + lin_b.v_b + ang_b.w_b.
 struct RowJacobian {

@@ -30,6 +30,52 @@ inline Mat3 skew(const Vec3& a) {
   return m;
 }
 
+/// A 3-vector from its components, its first two written as one pair.
+/// Eigen reads a Vec3 as a pair (x, y) and a single z; a vector written
+/// one component at a time and read back at once as a pair is a store the
+/// processor cannot forward (a stall of a dozen cycles or so).
+inline Vec3 vec3(Real x, Real y, Real z) {
+  Vec3 r;
+#if defined(__SSE2__)
+  _mm_storeu_pd(r.data(), _mm_set_pd(y, x));
+  r.z() = z;
+#else
+  r = Vec3(x, y, z);
+#endif
+  return r;
+}
+
+namespace math_detail {
+struct Components {
+  Real x, y, z;
+};
+// Eigen's q * v (uv = 2 (q_vec x v); v + w uv + q_vec x uv), the same
+// operations in the same order, so the same bits, by component.
+inline Components rotated(const Quat& q, const Vec3& v) {
+  const Real x = q.x(), y = q.y(), z = q.z(), w = q.w();
+  Real ux = y * v.z() - z * v.y(), uy = z * v.x() - x * v.z(), uz = x * v.y() - y * v.x();
+  ux += ux;
+  uy += uy;
+  uz += uz;
+  return {v.x() + w * ux + (y * uz - z * uy), v.y() + w * uy + (z * ux - x * uz), v.z() + w * uz + (x * uy - y * ux)};
+}
+}  // namespace math_detail
+
+/// q * v, the rotation of v by the unit quaternion q, bit for bit. Written
+/// out by component because Eigen's own form stores its intermediate a
+/// component at a time and reads it back as a pair (see vec3): a stall at
+/// every rotation of a joint's anchors.
+inline Vec3 rotate(const Quat& q, const Vec3& v) {
+  const math_detail::Components r = math_detail::rotated(q, v);
+  return vec3(r.x, r.y, r.z);
+}
+
+/// p + q * v (a body's point in the world), bit for bit.
+inline Vec3 rotateAdd(const Vec3& p, const Quat& q, const Vec3& v) {
+  const math_detail::Components r = math_detail::rotated(q, v);
+  return vec3(p.x() + r.x, p.y() + r.y, p.z() + r.z);
+}
+
 /// Exponential map (section 12.6.4): the unit quaternion of a rotation by
 /// |theta| radians about theta / |theta|. Below 1e-8 rad the Taylor series of
 /// sin(x/2)/x keeps the result exact to round-off instead of dividing by ~0.
@@ -69,8 +115,8 @@ struct Transform {
   Vec3 p = Vec3::Zero();  ///< translation (m)
   Quat q = Quat::Identity();  ///< rotation
 
-  Vec3 apply(const Vec3& local) const { return p + q * local; }  ///< local point to world
-  Vec3 applyInverse(const Vec3& world) const { return q.conjugate() * (world - p); }  ///< world point to local
+  Vec3 apply(const Vec3& local) const { return rotateAdd(p, q, local); }  ///< local point to world
+  Vec3 applyInverse(const Vec3& world) const { return rotate(q.conjugate(), world - p); }  ///< world point to local
   Transform operator*(const Transform& child) const {  ///< this after child: child frame to world
     return Transform{apply(child.p), (q * child.q).normalized()};
   }

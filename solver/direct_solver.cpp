@@ -92,22 +92,23 @@ DirectSolveStats DirectSolver::solve(std::span<ConstraintRow> rows, std::span<So
   DirectSolveStats st;
   const std::size_t n = rows.size();
 
-  // Starting impulse, and v = v* + M^-1 J^T lambda from here on.
-  for (ConstraintRow& r : rows) {
-    const bool applied = opt.velocities_include_lambda;
-    const Real start = opt.warm_start && std::isfinite(r.lambda) ? r.lambda : Real(0);
-    const Real already = applied && std::isfinite(r.lambda) ? r.lambda : Real(0);
-    applyRowImpulse(r, start - already, bodies);
-    r.lambda = start;
-  }
-
-  // Partition. Inert rows keep lambda = clamp(0, lo, hi) and no velocity.
+  // Starting impulse, and v = v* + M^-1 J^T lambda from here on; and the
+  // partition, in the same walk over the rows (a chain's 300 rows are
+  // 80 kB, past the first-level cache: each walk reads them again). Inert
+  // rows keep lambda = clamp(0, lo, hi) and no velocity.
   s.bilateral.clear();
   s.unilateral.clear();
   s.diag.assign(n, 0);
   s.coupling.resize(2 * n);
   for (std::size_t i = 0; i < n; ++i) {
     ConstraintRow& r = rows[i];
+    {
+      const bool applied = opt.velocities_include_lambda;
+      const Real start = opt.warm_start && std::isfinite(r.lambda) ? r.lambda : Real(0);
+      const Real already = applied && std::isfinite(r.lambda) ? r.lambda : Real(0);
+      applyRowImpulse(r, start - already, bodies);
+      r.lambda = start;
+    }
     const std::int32_t ca = couplingBodyA(r), cb = couplingBodyB(r);
     s.coupling[2 * i] = ca;
     s.coupling[2 * i + 1] = cb;

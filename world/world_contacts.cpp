@@ -46,7 +46,7 @@ struct RelativePose {
 };
 RelativePose relativePose(const Body& a, const Body& b) {
   const Quat a_inv = a.orientation.conjugate();
-  return {a_inv * (b.position - a.position), a_inv * b.orientation};
+  return {rotate(a_inv, b.position - a.position), a_inv * b.orientation};
 }
 
 // Contact recycling, after Jolt's body pair cache (PhysicsSettings::
@@ -78,7 +78,7 @@ bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::in
   Contact& c = out.back();
   c.enabled = true;  // the callback decides again
   c.carried = true;
-  c.normal = ba.orientation * o.made_normal;
+  c.normal = rotate(ba.orientation, o.made_normal);
   combineMaterials(w, ba, bb, c);
   const Transform ta = ba.transform(), tb = bb.transform();
   for (int i = 0; i < c.count; ++i) {
@@ -137,7 +137,7 @@ Real WorldImpl::contactDepth(const Contact& c) const {
     }
     const Body& b = bodies_[static_cast<size_t>(id.index)];
     x = b.position;
-    n_local = b.orientation.conjugate() * c.normal;
+    n_local = rotate(b.orientation.conjugate(), c.normal);
   };
   Vec3 xa, xb, na, nb;
   side(c.body_a, xa, na);
@@ -214,7 +214,7 @@ std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>&
     const RelativePose made = relativePose(ba, bb);
     c.made_offset = made.offset;
     c.made_rotation = made.rotation;
-    c.made_normal = ba.orientation.conjugate() * m.normal;
+    c.made_normal = rotate(ba.orientation.conjugate(), m.normal);
     const Transform ta = ba.transform(), tb = bb.transform();
     for (int i = 0; i < m.count; ++i) {
       ContactPointState& p = c.points[i];

@@ -33,10 +33,9 @@ void speculate(ConstraintRow& r, Real target) {
   if (r.correction != Correction::InRhs) r.bias_rhs = target;
 }
 
-
 // addRow's body, inlined where a part makes several rows at once (the
 // point part's three): the Jacobians stay in registers instead of being
-// stored for a call, and the unit axes' ones and zeros are known.
+// stored for a call, and the unit axes are constants.
 inline __attribute__((always_inline)) int appendRow(RowContext& ctx, const BodyView& a, const BodyView& b, int slot,
                                                     const Vec3& lin_a, const Vec3& ang_a, const Vec3& lin_b,
                                                     const Vec3& ang_b, Real c, const Softness* axis_softness, Real lo,

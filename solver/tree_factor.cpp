@@ -389,14 +389,15 @@ void TreeFactor::backwardGroup(const Group& g, double* w) const {
   }
 }
 
-// The group sizes the joints make most (a ball 3, a hinge 5, a fixed
-// joint 6) with their loops unrolled, as factorize's eliminate; the
-// arithmetic, and its order, is the same for every size.
+// The sizes factorize's eliminate unrolls (the joints' common ones: a
+// ball 3, a hinge 5, a fixed joint 6); the arithmetic, and its order, is
+// the same for every size.
 #define CAIRN_TREE_BY_SIZE(call)       \
   switch (g.size) {                   \
     case 1: call<1>(g, w); break;     \
     case 2: call<2>(g, w); break;     \
     case 3: call<3>(g, w); break;     \
+    case 4: call<4>(g, w); break;     \
     case 5: call<5>(g, w); break;     \
     case 6: call<6>(g, w); break;     \
     default: call<0>(g, w); break;    \

@@ -11,6 +11,9 @@
 
 #include <cmath>
 #include <limits>
+#if defined(__SSE2__)
+#include <emmintrin.h>  // vec3's paired store (Eigen includes it only when it vectorizes)
+#endif
 
 namespace cairn {
 

@@ -33,10 +33,11 @@ inline Mat3 skew(const Vec3& a) {
   return m;
 }
 
-/// A 3-vector from its components, its first two written as one pair.
-/// Eigen reads a Vec3 as a pair (x, y) and a single z; a vector written
-/// one component at a time and read back at once as a pair is a store the
-/// processor cannot forward (a stall of a dozen cycles or so).
+namespace math_detail {
+// A 3-vector from its components, its first two written as one pair.
+// Eigen reads a Vec3 as a pair (x, y) and a single z; a vector written
+// one component at a time and read back at once as a pair is a store the
+// processor cannot forward (a stall of a dozen cycles or so).
 inline Vec3 vec3(Real x, Real y, Real z) {
   Vec3 r;
 #if defined(__SSE2__)
@@ -48,7 +49,6 @@ inline Vec3 vec3(Real x, Real y, Real z) {
   return r;
 }
 
-namespace math_detail {
 struct Components {
   Real x, y, z;
 };
@@ -66,17 +66,17 @@ inline Components rotated(const Quat& q, const Vec3& v) {
 
 /// q * v, the rotation of v by the unit quaternion q, bit for bit. Written
 /// out by component because Eigen's own form stores its intermediate a
-/// component at a time and reads it back as a pair (see vec3): a stall at
+/// component at a time and reads it back as a pair (math_detail::vec3): a stall at
 /// every rotation of a joint's anchors.
 inline Vec3 rotate(const Quat& q, const Vec3& v) {
   const math_detail::Components r = math_detail::rotated(q, v);
-  return vec3(r.x, r.y, r.z);
+  return math_detail::vec3(r.x, r.y, r.z);
 }
 
 /// p + q * v (a body's point in the world), bit for bit.
 inline Vec3 rotateAdd(const Vec3& p, const Quat& q, const Vec3& v) {
   const math_detail::Components r = math_detail::rotated(q, v);
-  return vec3(p.x() + r.x, p.y() + r.y, p.z() + r.z);
+  return math_detail::vec3(p.x() + r.x, p.y() + r.y, p.z() + r.z);
 }
 
 /// Exponential map (section 12.6.4): the unit quaternion of a rotation by

@@ -40,7 +40,7 @@ TEST(Rotate, GivesEigensQuaternionProductBitForBit) {
 }
 
 TEST(Rotate, Vec3HoldsItsComponents) {
-  const Vec3 v = vec3(1.5, -0.0, 3e-300);
+  const Vec3 v = math_detail::vec3(1.5, -0.0, 3e-300);
   EXPECT_EQ(v.x(), 1.5);
   EXPECT_TRUE(std::signbit(v.y()));
   EXPECT_EQ(v.z(), 3e-300);

@@ -181,8 +181,10 @@ void WorldImpl::dropDiagnosticsOf(BodyId id) {
   size_t kept = 0;
   for (size_t i = 0; i < diagnostics_.size(); ++i) {
     if (diagnostics_[i].body.index == id.index) continue;
-    diagnostics_[kept] = std::move(diagnostics_[i]);
-    diagnostic_last_step_[kept] = diagnostic_last_step_[i];
+    if (kept != i) {  // a record moved onto itself would lose its strings (a moved-from string is empty)
+      diagnostics_[kept] = std::move(diagnostics_[i]);
+      diagnostic_last_step_[kept] = diagnostic_last_step_[i];
+    }
     ++kept;
   }
   diagnostics_.resize(kept);

@@ -189,16 +189,17 @@ void WorldImpl::dropDiagnosticsOf(BodyId id) {
   }
   diagnostics_.resize(kept);
   diagnostic_last_step_.resize(kept);
+  diagnostic_index_.invalidate();
 }
 
 void WorldImpl::diagnose(std::int32_t body, const char* kind, const std::string& detail, bool once_per_step) {
   // A restored snapshot brings its diagnostics but not the step each was
   // last counted in.
   if (diagnostic_last_step_.size() < diagnostics_.size()) diagnostic_last_step_.resize(diagnostics_.size(), -1);
-  for (size_t i = 0; i < diagnostics_.size(); ++i) {
-    Diagnostic& d = diagnostics_[i];
-    if (d.body.index != body || d.kind != kind) continue;
+  if (const std::int32_t at = diagnostic_index_.find(diagnostics_, body, kind); at >= 0) {
+    const auto i = static_cast<size_t>(at);
     if (once_per_step && diagnostic_last_step_[i] == step_count_) return;
+    Diagnostic& d = diagnostics_[i];
     ++d.count;
     diagnostic_last_step_[i] = step_count_;
     d.detail = detail;  // the latest figures
@@ -207,6 +208,7 @@ void WorldImpl::diagnose(std::int32_t body, const char* kind, const std::string&
   diagnostic_last_step_.push_back(step_count_);
   if (body < 0) diagnostics_.push_back({kWorldBody, "world", kind, detail, step_count_, 1});
   else diagnostics_.push_back({bodyId(body), bodies_[static_cast<size_t>(body)].name, kind, detail, step_count_, 1});
+  diagnostic_index_.add(body, diagnostics_.back().kind, static_cast<std::int32_t>(diagnostics_.size()) - 1);
 }
 
 // The guards' walks read every moving body after each stage: on the pool's

@@ -27,6 +27,7 @@
 #include "solver/solver_body.hpp"
 #include "solver/worker_pool.hpp"
 #include "world/cost_split.hpp"
+#include "world/diagnostic_index.hpp"
 #include "world/pool_watch.hpp"
 
 #include <memory>
@@ -421,6 +422,7 @@ class WorldImpl {
   std::vector<NumericalEvent> numerical_events_;
   std::vector<Diagnostic> diagnostics_;
   std::vector<int> diagnostic_last_step_;  // per diagnostic: the last step it was counted in
+  DiagnosticIndex diagnostic_index_;       // where diagnose finds a body's record of a kind
   std::vector<JointBreakEvent> break_events_;
 
   // Forgets a body's diagnostics (it is being destroyed).

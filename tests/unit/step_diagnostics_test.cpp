@@ -114,13 +114,15 @@ TEST(StepDiagnostics, DestroyingABodyDropsItsRecords) {
 }
 
 // A body's reports of one kind are counted in one record, whatever happens
-// to the records around it. Six boxes sunk 0.3 m into the ground (past
-// slop + penetration_drift, 5.5 cm, for the seven steps: the push-out
-// moves them a few cm a step) are reported every step; a snapshot is
-// restored into another World, and in both one box is destroyed (its
-// records go, the others close up: moving each record onto itself once
-// emptied the strings of those before it, and their reports then started
-// new records). Both worlds then hold the same records, one per body and
+// to the records around it (diagnose finds the record through an index,
+// world/diagnostic_index.hpp, rebuilt when the records change without
+// it). Six boxes sunk 0.3 m into the ground (past slop +
+// penetration_drift, 5.5 cm, for the seven steps: the push-out moves them
+// a few cm a step) are reported every step; a snapshot is restored into
+// another World, and in both one box is destroyed (its records go, the
+// others close up: moving each record onto itself once emptied the
+// strings of those before it, and their reports then started new
+// records). Both worlds then hold the same records, one per body and
 // kind, and each box left has one penetration record counted in all
 // seven steps.
 TEST(StepDiagnostics, EachBodyKeepsOneRecordPerKindAsRecordsMoveAndReturn) {

@@ -25,7 +25,6 @@ PositionPassStats solvePositionPass(DirectSolver& solver, std::vector<Constraint
   d.outer_iterations = 1;  // bilateral rows only: one exact solve
   d.warm_start = false;    // a correction from zero, never last step's
   d.report_residual = false;  // the pass measures its own error
-  std::vector<SolverBody> back;
   while (st.iterations < options.max_iterations && st.error_after > options.tolerance) {
     std::fill(bodies.begin(), bodies.end(), SolverBody{});
     const DirectSolveStats ds = solver.solve(rows, bodies, d);
@@ -50,15 +49,16 @@ PositionPassStats solvePositionPass(DirectSolver& solver, std::vector<Constraint
         accepted = true;
         break;
       }
-      back.assign(bodies.begin(), bodies.end());
-      for (SolverBody& b : back) {
+      // Taken back in place (negation is exact): a copy would allocate
+      // in the step.
+      for (SolverBody& b : bodies) {
         b.v = -b.v;
         b.w = -b.w;
       }
-      move(back);
+      move(bodies);
       for (SolverBody& b : bodies) {
-        b.v /= scale;
-        b.w /= scale;
+        b.v = -b.v / scale;
+        b.w = -b.w / scale;
       }
     }
     ++st.iterations;

@@ -14,6 +14,7 @@
 #include "world/position_pass_stage.hpp"
 
 #include <algorithm>
+#include <functional>
 
 namespace cairn::detail {
 
@@ -110,7 +111,10 @@ void correctJointPositions(WorldImpl& w, StepContext& ctx) {
   PositionPassOptions o;
   o.max_iterations = s.position_iterations;
   o.h = h;
-  const PositionPassStats st = solvePositionPass(w.position_solver_, ctx.position_rows, ctx.position_bodies, build, move, o);
+  // By reference: std::function keeps a reference_wrapper in place, where
+  // a copy of either lambda would be allocated every substep.
+  const PositionPassStats st =
+      solvePositionPass(w.position_solver_, ctx.position_rows, ctx.position_bodies, std::ref(build), std::ref(move), o);
   w.stats_.position_iterations += st.iterations;
   w.stats_.position_error = std::max(w.stats_.position_error, st.error_after);
 }

@@ -128,9 +128,12 @@ void assembleSparseLower(std::span<const ConstraintRow> rows, std::span<const in
   }
 }
 
-Eigen::MatrixXd assembleDenseA(std::span<const ConstraintRow> rows, CfmOnDiagonal cfm) {
+namespace {
+
+// Into `a` and `b`, resized (their storage is kept when the size is).
+void fillDenseA(std::span<const ConstraintRow> rows, CfmOnDiagonal cfm, Eigen::MatrixXd& a) {
   const auto n = static_cast<Eigen::Index>(rows.size());
-  Eigen::MatrixXd a(n, n);
+  a.resize(n, n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const ConstraintRow& ri = rows[static_cast<std::size_t>(i)];
     for (Eigen::Index j = 0; j <= i; ++j) {
@@ -138,12 +141,24 @@ Eigen::MatrixXd assembleDenseA(std::span<const ConstraintRow> rows, CfmOnDiagona
     }
     if (cfm == CfmOnDiagonal::Include) a(i, i) += ri.cfm;
   }
+}
+
+void fillB(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies, Eigen::VectorXd& b) {
+  b.resize(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) b(static_cast<Eigen::Index>(i)) = rowJv(rows[i], bodies) - rows[i].rhs;
+}
+
+}  // namespace
+
+Eigen::MatrixXd assembleDenseA(std::span<const ConstraintRow> rows, CfmOnDiagonal cfm) {
+  Eigen::MatrixXd a;
+  fillDenseA(rows, cfm, a);
   return a;
 }
 
 Eigen::VectorXd assembleB(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {
-  Eigen::VectorXd b(static_cast<Eigen::Index>(rows.size()));
-  for (std::size_t i = 0; i < rows.size(); ++i) b(static_cast<Eigen::Index>(i)) = rowJv(rows[i], bodies) - rows[i].rhs;
+  Eigen::VectorXd b;
+  fillB(rows, bodies, b);
   return b;
 }
 
@@ -165,11 +180,10 @@ Eigen::SparseMatrix<double> assembleSparseA(std::span<const ConstraintRow> rows,
   return full;
 }
 
-DenseLcp assembleDenseLcp(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {
-  DenseLcp lcp;
+void assembleDenseLcp(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies, DenseLcp& lcp) {
   const auto n = static_cast<Eigen::Index>(rows.size());
-  lcp.A = assembleDenseA(rows, CfmOnDiagonal::Include);
-  lcp.b = assembleB(rows, bodies);
+  fillDenseA(rows, CfmOnDiagonal::Include, lcp.A);
+  fillB(rows, bodies, lcp.b);
   lcp.lo.resize(n);
   lcp.hi.resize(n);
   lcp.mu.resize(n);
@@ -181,6 +195,11 @@ DenseLcp assembleDenseLcp(std::span<const ConstraintRow> rows, std::span<const S
     lcp.mu(k) = rows[i].mu;
     lcp.normal_row[i] = rows[i].normal_row;
   }
+}
+
+DenseLcp assembleDenseLcp(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies) {
+  DenseLcp lcp;
+  assembleDenseLcp(rows, bodies, lcp);
   return lcp;
 }
 

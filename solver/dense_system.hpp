@@ -137,5 +137,8 @@ struct DenseLcp {
   std::vector<int> normal_row;
 };
 DenseLcp assembleDenseLcp(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies);
+// The same into `lcp`, whose storage is kept where the size is (the step's
+// exact solve, every substep).
+void assembleDenseLcp(std::span<const ConstraintRow> rows, std::span<const SolverBody> bodies, DenseLcp& lcp);
 
 }  // namespace cairn

@@ -48,7 +48,16 @@ constexpr int kNewtonSteps = 8;
 // deletion are written here, O(|C|^2) each.
 class ClampedFactor {
  public:
-  explicit ClampedFactor(Index capacity) : l_(capacity, capacity) {}
+  // Ready for problems of n rows. Every vector and matrix here keeps its
+  // storage from solve to solve while n stays the same (Eigen's dynamic
+  // objects reallocate on any change of size): the step's exact solve
+  // allocates nothing once warm.
+  void reset(Index n) {
+    l_.resize(n, n);
+    z_.resize(n);
+    x_.resize(n);
+    clear();
+  }
 
   Index size() const { return m_; }
   int updates() const { return updates_; }
@@ -57,11 +66,13 @@ class ClampedFactor {
     updates_ = 0;
   }
 
-  // Borders L with a new last row for a = A[C, k] (in C order) and
-  // akk = A_kk. Fails, leaving L unchanged, when the Schur complement
-  // akk - |L^-1 a|^2 is not above min_pivot (k depends linearly on C).
+  // Borders L with a new last row for a = A[C, k] (in C order, the first
+  // size() entries of `a`) and akk = A_kk. Fails, leaving L unchanged,
+  // when the Schur complement akk - |L^-1 a|^2 is not above min_pivot (k
+  // depends linearly on C).
   bool append(const VectorXd& a, double akk, double min_pivot) {
-    VectorXd z = a;
+    auto z = z_.head(m_);
+    z = a.head(m_);
     if (m_ > 0) l_.topLeftCorner(m_, m_).triangularView<Eigen::Lower>().solveInPlace(z);
     const double d2 = akk - z.squaredNorm();
     if (!(d2 > min_pivot)) return false;
@@ -78,9 +89,14 @@ class ClampedFactor {
   void remove(Index p) {
     const Index r = m_ - 1 - p;
     if (r > 0) {
-      VectorXd x = l_.col(p).segment(p + 1, r);
-      if (p > 0) l_.block(p, 0, r, p) = l_.block(p + 1, 0, r, p).eval();
-      l_.block(p, p, r, r) = l_.block(p + 1, p + 1, r, r).eval();
+      auto x = x_.head(r);
+      x = l_.col(p).segment(p + 1, r);
+      // Rows p+1.. up by one (and, right of column p, left by one), in
+      // place: each entry is read before its own place is written.
+      for (Index j = 0; j < p; ++j)
+        for (Index i = 0; i < r; ++i) l_(p + i, j) = l_(p + i + 1, j);
+      for (Index j = 0; j < r; ++j)
+        for (Index i = 0; i < r; ++i) l_(p + i, p + j) = l_(p + i + 1, p + j + 1);
       for (Index k = 0; k < r; ++k) {
         const Index kk = p + k;
         const double lkk = l_(kk, kk);
@@ -100,8 +116,8 @@ class ClampedFactor {
     ++updates_;
   }
 
-  // x := A[C, C]^-1 x.
-  void solveInPlace(VectorXd& x) const {
+  // x := A[C, C]^-1 x (x of size() entries).
+  void solveInPlace(Eigen::Ref<VectorXd> x) const {
     const auto lm = l_.topLeftCorner(m_, m_);
     lm.triangularView<Eigen::Lower>().solveInPlace(x);
     lm.transpose().triangularView<Eigen::Upper>().solveInPlace(x);
@@ -109,6 +125,7 @@ class ClampedFactor {
 
  private:
   MatrixXd l_;
+  VectorXd z_, x_;  // append's and remove's scratch
   Index m_ = 0;
   int updates_ = 0;
 };
@@ -130,10 +147,26 @@ struct Problem {
   int max_pivots = 0;
 };
 
+// A pass's storage, kept by the solver's workspace from solve to solve.
+struct PassScratch {
+  ClampedFactor factor;
+  VectorXd x, lo, hi;
+  VectorXd col, r, w, dw, dxc;  // A[C, k], refineClamped's residual, drive's w, dw and dx_C
+  std::vector<RowState> state;
+  std::vector<int> clamped, refactor;
+};
+
 class DantzigPass {
  public:
-  explicit DantzigPass(const Problem& pb)
-      : pb_(pb), a_(*pb.A), b_(*pb.b), n_(pb.b->size()), factor_(n_) {}
+  DantzigPass(const Problem& pb, PassScratch& s)
+      : x(s.x), lo(s.lo), hi(s.hi), pb_(pb), a_(*pb.A), b_(*pb.b), n_(pb.b->size()), factor_(s.factor),
+        state_(s.state), clamped_(s.clamped), refactor_(s.refactor), col_(s.col), r_(s.r), w_(s.w), dw_(s.dw),
+        dxc_(s.dxc) {
+    factor_.reset(n_);
+    for (VectorXd* v : {&x, &lo, &hi, &col_, &r_, &w_, &dw_, &dxc_}) v->resize(n_);
+    clamped_.reserve(static_cast<std::size_t>(n_));
+    refactor_.reserve(static_cast<std::size_t>(n_));
+  }
 
   // One complete solve with the friction bounds taken from `friction_source`
   // (fixed for the pass) or, when null, from x itself when the first
@@ -191,7 +224,7 @@ class DantzigPass {
 
   RowState state(Index i) const { return state_[static_cast<std::size_t>(i)]; }
 
-  VectorXd x, lo, hi;
+  VectorXd &x, &lo, &hi;
 
  private:
   enum class Event { None, DriveToC, DriveToLo, DriveToHi, ClampedToLo, ClampedToHi, BoundToC };
@@ -209,8 +242,9 @@ class DantzigPass {
   }
 
   bool addToClamped(int k) {
-    const VectorXd col = a_(clamped_, k);
-    if (!factor_.append(col, a_(k, k), minPivot(k))) return false;
+    const auto m = static_cast<Index>(clamped_.size());
+    for (Index c = 0; c < m; ++c) col_(c) = a_(clamped_[static_cast<std::size_t>(c)], k);
+    if (!factor_.append(col_, a_(k, k), minPivot(k))) return false;
     clamped_.push_back(k);
     state_[static_cast<std::size_t>(k)] = RowState::Clamped;
     return true;
@@ -219,10 +253,10 @@ class DantzigPass {
   // Refactors A[C, C] from scratch, bounding the round-off that successive
   // updates accumulate.
   bool refactor() {
-    const std::vector<int> c = clamped_;
+    refactor_.assign(clamped_.begin(), clamped_.end());
     clamped_.clear();
     factor_.clear();
-    for (int k : c) {
+    for (int k : refactor_) {
       if (!addToClamped(k)) return false;
     }
     return true;
@@ -232,20 +266,34 @@ class DantzigPass {
   // step on the linear equations, i.e. an exact re-solve).
   void refineClamped() {
     if (clamped_.empty()) return;
-    VectorXd r = a_(Eigen::all, clamped_).transpose() * x + b_(clamped_);
+    // r = A[:, C]^T x + b[C], by index (Eigen's indexed views copy the
+    // index list, an allocation each). The arithmetic of Eigen's product
+    // of an indexed view: per entry, the products summed in row order, added
+    // to a zeroed result, then b.
+    const auto m = static_cast<Index>(clamped_.size());
+    auto r = r_.head(m);
+    for (Index c = 0; c < m; ++c) {
+      const auto col = a_.col(clamped_[static_cast<std::size_t>(c)]);
+      double sum = col(0) * x(0);
+      for (Index k = 1; k < n_; ++k) sum += col(k) * x(k);
+      r(c) = (0.0 + sum) + b_(clamped_[static_cast<std::size_t>(c)]);
+    }
     factor_.solveInPlace(r);
-    x(clamped_) -= r;
+    for (Index c = 0; c < m; ++c) x(clamped_[static_cast<std::size_t>(c)]) -= r(c);
   }
 
   PassStatus drive(int d, int& pivots) {
-    VectorXd w = a_ * x + b_;
-    VectorXd dw(n_);
+    VectorXd& w = w_;
+    VectorXd& dw = dw_;
+    w.noalias() = a_ * x;  // (A x)_i, then + b_i: the sum's order
+    w += b_;
     for (;;) {
       if (++pivots > pb_.max_pivots) return PassStatus::Failed;
       if (w(d) == 0 && lo(d) < x(d) && x(d) < hi(d)) return addToClamped(d) ? PassStatus::Ok : PassStatus::Singular;
       const double dir = w(d) > 0 ? -1.0 : 1.0;
 
-      VectorXd dxc = a_(clamped_, d);
+      auto dxc = dxc_.head(static_cast<Index>(clamped_.size()));
+      for (Index c = 0; c < dxc.size(); ++c) dxc(c) = a_(clamped_[static_cast<std::size_t>(c)], d);
       factor_.solveInPlace(dxc);
       dxc *= -dir;
       dw = dir * a_.col(d);
@@ -305,7 +353,7 @@ class DantzigPass {
         return dir * dw(d) <= minPivot(d) + pb_.tiny_dw ? PassStatus::Singular : PassStatus::Failed;
       }
       t = std::max(t, 0.0);  // round-off can leave a row a hair past its bound
-      x(clamped_) += t * dxc;
+      for (Index c = 0; c < dxc.size(); ++c) x(clamped_[static_cast<std::size_t>(c)]) += t * dxc(c);
       x(d) += t * dir;
       w += t * dw;
 
@@ -343,7 +391,8 @@ class DantzigPass {
       }
       // Keep w exact between pivots of a long drive.
       refineClamped();
-      w = a_ * x + b_;
+      w.noalias() = a_ * x;
+      w += b_;
     }
   }
 
@@ -351,15 +400,40 @@ class DantzigPass {
   const MatrixXd& a_;
   const VectorXd& b_;
   Index n_;
-  ClampedFactor factor_;
-  std::vector<RowState> state_;
-  std::vector<int> clamped_;
+  ClampedFactor& factor_;
+  std::vector<RowState>& state_;
+  std::vector<int>& clamped_;
+  std::vector<int>& refactor_;
+  VectorXd &col_, &r_, &w_, &dw_, &dxc_;
 };
+
+// Everything a solve needs beyond its input, kept between solves: after
+// the first solves of a size, the step's exact solve allocates nothing.
+struct LcpWorkspace {
+  DenseLcp lcp;          // solveLcpExact's assembled problem
+  Problem pb, truth;     // the problem as pivoted, and as reported
+  PassScratch pass;
+  VectorXd w;            // A x + b, for the residual and the natural map's sets
+  VectorXd best, prev, cur, next;
+  MatrixXd a_reg;        // A + r I after a singular restart
+  MatrixXd m;            // the Newton step's system
+  VectorXd q;
+  Eigen::PartialPivLU<MatrixXd> lu;
+  std::vector<RowState> sets, next_sets;
+  std::vector<int> normal;  // solveDense's friction rows
+  VectorXd mu, lo, hi, x;   // solveDense's bounds and its answer
+};
+
+// w := A x + b, as (A x)_i + b_i.
+void residualVelocity(const MatrixXd& a, const VectorXd& b, const VectorXd& x, VectorXd& w) {
+  w.noalias() = a * x;
+  w += b;
+}
 
 // max_i |F_i| of the natural map with w = A x + b and the friction bounds
 // implied by x itself (the coupled problem's residual).
-double coupledResidual(const MatrixXd& a, const VectorXd& b, const VectorXd& x, const Problem& pb) {
-  const VectorXd w = a * x + b;
+double coupledResidual(const MatrixXd& a, const VectorXd& b, const VectorXd& x, const Problem& pb, VectorXd& w) {
+  residualVelocity(a, b, x, w);
   double res = 0;
   for (Index i = 0; i < x.size(); ++i) {
     double lo = pb.lo(i), hi = pb.hi(i);
@@ -390,12 +464,14 @@ double frictionBoundChange(const DantzigPass& pass, const Problem& pb) {
 //   row at a fixed bound:   x_i = lo_i or hi_i
 //   friction at a bound:    x_i = -+ mu_i sgn(mu_i x_n) x_n   (n its normal)
 // Solved with a pivoted LU (the friction rows make it unsymmetric). `x`
-// gives the signs of the normal impulses.
+// gives the signs of the normal impulses; the answer goes to ws.next.
 bool solveActiveSet(const MatrixXd& a, const VectorXd& b, const std::vector<RowState>& sets, const VectorXd& x,
-                    const Problem& pb, VectorXd& out) {
+                    const Problem& pb, LcpWorkspace& ws) {
   const Index n = b.size();
-  MatrixXd m = MatrixXd::Zero(n, n);
-  VectorXd q = VectorXd::Zero(n);
+  MatrixXd& m = ws.m;
+  VectorXd& q = ws.q;
+  m.setZero(n, n);
+  q.setZero(n);
   for (Index i = 0; i < n; ++i) {
     const RowState st = sets[static_cast<std::size_t>(i)];
     if (st == RowState::Clamped) {
@@ -414,15 +490,17 @@ bool solveActiveSet(const MatrixXd& a, const VectorXd& b, const std::vector<RowS
       m(i, nr) -= (st == RowState::AtHi ? 1.0 : -1.0) * sign * pb.mu(i);
     }
   }
-  out = Eigen::PartialPivLU<MatrixXd>(m).solve(q);
-  return out.allFinite();
+  ws.lu.compute(m);
+  ws.next = ws.lu.solve(q);
+  return ws.next.allFinite();
 }
 
 // The index sets the natural map selects at x: the branch of
 // clamp(x_i - w_i, lo_i, hi_i) each row is on (bounds coupled to x).
-std::vector<RowState> naturalMapSets(const MatrixXd& a, const VectorXd& b, const VectorXd& x, const Problem& pb) {
-  const VectorXd w = a * x + b;
-  std::vector<RowState> sets(static_cast<std::size_t>(x.size()));
+void naturalMapSets(const MatrixXd& a, const VectorXd& b, const VectorXd& x, const Problem& pb, VectorXd& w,
+                    std::vector<RowState>& sets) {
+  residualVelocity(a, b, x, w);
+  sets.resize(static_cast<std::size_t>(x.size()));
   for (Index i = 0; i < x.size(); ++i) {
     double lo = pb.lo(i), hi = pb.hi(i);
     const int nr = pb.normal[static_cast<std::size_t>(i)];
@@ -433,25 +511,30 @@ std::vector<RowState> naturalMapSets(const MatrixXd& a, const VectorXd& b, const
     const double z = x(i) - w(i);
     sets[static_cast<std::size_t>(i)] = z <= lo ? RowState::AtLo : (z >= hi ? RowState::AtHi : RowState::Clamped);
   }
-  return sets;
 }
 
-VectorXd solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, const VectorXd& hi,
-                   const std::vector<int>& normal_in, const VectorXd& mu, const ExactLcpOptions& opt,
-                   ExactLcpResult& res) {
+// The answer in ws.best (size n).
+void solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, const VectorXd& hi,
+               const std::vector<int>& normal_in, const VectorXd& mu, const ExactLcpOptions& opt,
+               ExactLcpResult& res, LcpWorkspace& ws) {
   const Index n = b.size();
   res = ExactLcpResult{};
+  VectorXd& best = ws.best;
   if (n == 0) {
     res.converged = true;
-    return VectorXd();
+    best.resize(0);
+    return;
   }
 
-  Problem pb;
+  Problem& pb = ws.pb;
+  pb.A = nullptr;
   pb.b = &b;
   pb.lo = lo;
   pb.hi = hi;
   pb.mu = mu;
   pb.normal.assign(static_cast<std::size_t>(n), -1);
+  pb.order.clear();
+  pb.num_unbounded = 0;
   for (Index i = 0; i < n; ++i) {
     const int nr = normal_in.empty() ? -1 : normal_in[static_cast<std::size_t>(i)];
     if (nr >= 0 && nr < n && nr != i) {
@@ -461,7 +544,7 @@ VectorXd solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, con
     }
   }
   // The reported residual uses these bounds; the pivoting may pin rows.
-  Problem truth = pb;
+  ws.truth = pb;
   // An inert row (zero row and column of A: it moves no body and has no
   // cfm) cannot change any w, not even its own: pin its lambda at
   // clamp(0, lo, hi) instead of letting it make A singular.
@@ -490,34 +573,35 @@ VectorXd solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, con
   pb.max_pivots = opt.max_pivots > 0 ? opt.max_pivots : static_cast<int>(20 * n + 100);
   const int max_passes = has_friction ? std::max(1, opt.max_friction_iterations) : 1;
 
-  VectorXd best;
+  bool have_best = false;
   double best_res = kInfD;
-  MatrixXd a_reg;
   for (int attempt = 0; attempt < 2; ++attempt) {
     if (attempt == 1) {
       res.regularized = true;
       res.regularization = opt.regularization * scale;
-      a_reg = a;
-      a_reg.diagonal().array() += res.regularization;
+      ws.a_reg = a;
+      ws.a_reg.diagonal().array() += res.regularization;
     }
-    pb.A = attempt == 0 ? &a : &a_reg;
+    pb.A = attempt == 0 ? &a : &ws.a_reg;
     pb.singular_pivot = attempt == 0 ? opt.singular_pivot : 0.0;
 
-    DantzigPass pass(pb);
-    VectorXd prev;
+    DantzigPass pass(pb, ws.pass);
+    VectorXd& prev = ws.prev;
+    bool have_prev = false;
     bool singular = false;
     res.converged = false;
     res.friction_iterations = 0;
-    best.resize(0);
+    have_best = false;
     best_res = kInfD;
     // Keeps the candidate with the smallest residual of the problem being
     // solved: the regularized matrix after a restart, inert rows pinned
     // (an inert row's w may be unsatisfiable; that is not the solver's
     // error and must not block convergence of the others).
     auto consider = [&](const VectorXd& x) {
-      const double r = coupledResidual(*pb.A, b, x, pb);
+      const double r = coupledResidual(*pb.A, b, x, pb, ws.w);
       if (r < best_res) {
         best = x;
+        have_best = true;
         best_res = r;
       }
       return r;
@@ -526,14 +610,17 @@ VectorXd solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, con
     for (int k = 0; k < max_passes; ++k) {
       ++res.friction_iterations;
       int pass_pivots = 0;
-      const PassStatus st = pass.run(prev.size() == n ? &prev : nullptr, pass_pivots);
+      const PassStatus st = pass.run(have_prev ? &prev : nullptr, pass_pivots);
       res.pivots += pass_pivots;
       if (st == PassStatus::Singular) {
         singular = true;
         break;
       }
       if (st == PassStatus::Failed) {
-        if (best.size() == 0 && pass.x.allFinite()) consider(pass.x.cwiseMax(pass.lo).cwiseMin(pass.hi));
+        if (!have_best && pass.x.allFinite()) {
+          ws.cur = pass.x.cwiseMax(pass.lo).cwiseMin(pass.hi);
+          consider(ws.cur);
+        }
         break;
       }
       consider(pass.x);
@@ -547,6 +634,7 @@ VectorXd solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, con
       if (k == 0) x_scale = pass.x.lpNorm<Eigen::Infinity>();
       if (frictionBoundChange(pass, pb) <= opt.tolerance * x_scale) {
         best = pass.x;  // the bounds it was solved with are its own: exact
+        have_best = true;
         res.converged = true;
         break;
       }
@@ -554,24 +642,27 @@ VectorXd solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, con
       // its normal, make one linear system whose solution is exact when
       // those sets are the coupled problem's.
       if (opt.polish_active_set) {
-        std::vector<RowState> sets(static_cast<std::size_t>(n));
+        std::vector<RowState>& sets = ws.sets;
+        sets.resize(static_cast<std::size_t>(n));
         for (Index i = 0; i < n; ++i) sets[static_cast<std::size_t>(i)] = pass.state(i);
         // Not the candidate's own scale either: a nearly singular Newton
         // system can return huge impulses whose residual is small only
         // relative to themselves. F mixes impulse and velocity entries.
         const double f_scale = std::max({b.lpNorm<Eigen::Infinity>(), max_diag * x_scale, x_scale});
-        VectorXd cur = pass.x, next;
-        for (int it = 0; it < kNewtonSteps && solveActiveSet(*pb.A, b, sets, cur, pb, next); ++it) {
-          cur = next;
+        VectorXd& cur = ws.cur;
+        cur = pass.x;
+        for (int it = 0; it < kNewtonSteps && solveActiveSet(*pb.A, b, sets, cur, pb, ws); ++it) {
+          cur = ws.next;
           const double r = consider(cur);
           if (r <= opt.tolerance * f_scale) {
             best = cur;
+            have_best = true;
             res.converged = true;
             break;
           }
-          std::vector<RowState> next_sets = naturalMapSets(*pb.A, b, cur, pb);
-          if (next_sets == sets) break;  // Newton stalled on this piece
-          sets = std::move(next_sets);
+          naturalMapSets(*pb.A, b, cur, pb, ws.w, ws.next_sets);
+          if (ws.next_sets == sets) break;  // Newton stalled on this piece
+          std::swap(sets, ws.next_sets);
         }
         if (res.converged) break;
       }
@@ -579,57 +670,87 @@ VectorXd solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, con
       // The plain iteration x -> pass(bounds(x)) oscillates when friction
       // strongly changes the normals (large mu, lever arms); averaging
       // (Krasnoselskii-Mann) damps that and keeps the same fixed points.
-      prev = prev.size() == n ? VectorXd(0.5 * (prev + pass.x)) : pass.x;
+      if (have_prev) {
+        prev = 0.5 * (prev + pass.x);
+      } else {
+        prev = pass.x;
+        have_prev = true;
+      }
     }
     if (!singular || attempt == 1) break;
   }
-  if (best.size() != n || !best.allFinite()) {
-    best = VectorXd::Zero(n);
+  if (!have_best || best.size() != n || !best.allFinite()) {
+    best.setZero(n);
     res.converged = false;
   }
-  res.residual = coupledResidual(a, b, best, truth);
-  return best;
+  res.residual = coupledResidual(a, b, best, ws.truth, ws.w);
 }
 
 }  // namespace
 
-ExactLcpResult solveLcpExact(std::span<ConstraintRow> rows, std::span<SolverBody> bodies,
-                             const ExactLcpOptions& options) {
+struct ExactLcpSolver::Impl {
+  LcpWorkspace ws;
+};
+
+ExactLcpSolver::ExactLcpSolver() : impl_(std::make_unique<Impl>()) {}
+ExactLcpSolver::~ExactLcpSolver() = default;
+ExactLcpSolver::ExactLcpSolver(ExactLcpSolver&&) noexcept = default;
+ExactLcpSolver& ExactLcpSolver::operator=(ExactLcpSolver&&) noexcept = default;
+
+ExactLcpResult ExactLcpSolver::solve(std::span<ConstraintRow> rows, std::span<SolverBody> bodies,
+                                     const ExactLcpOptions& options) {
+  LcpWorkspace& ws = impl_->ws;
   if (options.velocities_include_lambda) {
     for (const ConstraintRow& r : rows) {
       if (std::isfinite(r.lambda)) applyRowImpulse(r, -r.lambda, bodies);
     }
   }
-  const DenseLcp lcp = assembleDenseLcp(rows, bodies);
+  DenseLcp& lcp = ws.lcp;
+  assembleDenseLcp(rows, bodies, lcp);
   ExactLcpResult res;
-  const VectorXd x = solveCore(lcp.A, lcp.b, lcp.lo, lcp.hi, lcp.normal_row, lcp.mu, options, res);
+  solveCore(lcp.A, lcp.b, lcp.lo, lcp.hi, lcp.normal_row, lcp.mu, options, res, ws);
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    rows[i].lambda = x(static_cast<Index>(i));
+    rows[i].lambda = ws.best(static_cast<Index>(i));
     applyRowImpulse(rows[i], rows[i].lambda, bodies);
   }
   res.residual = lcpResidual(rows, bodies, ResidualNorm::Max);
   return res;
 }
 
-Eigen::VectorXd solveLcpExactDense(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& lo,
-                                   const Eigen::VectorXd& hi, std::span<const int> findex,
-                                   const ExactLcpOptions& options, ExactLcpResult* result) {
+const Eigen::VectorXd& ExactLcpSolver::solveDense(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+                                                  const Eigen::VectorXd& lo, const Eigen::VectorXd& hi,
+                                                  std::span<const int> findex, const ExactLcpOptions& options,
+                                                  ExactLcpResult* result) {
+  LcpWorkspace& ws = impl_->ws;
   const Index n = b.size();
-  std::vector<int> normal(static_cast<std::size_t>(n), -1);
-  VectorXd mu = VectorXd::Zero(n);
-  VectorXd lo2 = lo, hi2 = hi;
+  ws.normal.assign(static_cast<std::size_t>(n), -1);
+  ws.mu.setZero(n);
+  ws.lo = lo;
+  ws.hi = hi;
   for (Index i = 0; i < n && static_cast<std::size_t>(i) < findex.size(); ++i) {
     const int f = findex[static_cast<std::size_t>(i)];
     if (f < 0 || f >= n || f == i) continue;  // not a (valid) friction row: its own bounds
-    normal[static_cast<std::size_t>(i)] = f;
-    mu(i) = hi(i);  // ODE's convention: hi carries mu for friction rows
-    lo2(i) = 0;
-    hi2(i) = 0;
+    ws.normal[static_cast<std::size_t>(i)] = f;
+    ws.mu(i) = hi(i);  // ODE's convention: hi carries mu for friction rows
+    ws.lo(i) = 0;
+    ws.hi(i) = 0;
   }
   ExactLcpResult res;
-  VectorXd x = solveCore(A, b, lo2, hi2, normal, mu, options, res);
+  solveCore(A, b, ws.lo, ws.hi, ws.normal, ws.mu, options, res, ws);
   if (result != nullptr) *result = res;
-  return x;
+  return ws.best;
+}
+
+ExactLcpResult solveLcpExact(std::span<ConstraintRow> rows, std::span<SolverBody> bodies,
+                             const ExactLcpOptions& options) {
+  return ExactLcpSolver().solve(rows, bodies, options);
+}
+
+Eigen::VectorXd solveLcpExactDense(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& lo,
+                                   const Eigen::VectorXd& hi, std::span<const int> findex,
+                                   const ExactLcpOptions& options, ExactLcpResult* result) {
+  ExactLcpSolver solver;
+  return solver.solveDense(A, b, lo, hi, findex, options, result);
 }
 
 }  // namespace cairn

@@ -50,6 +50,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <span>
 
 namespace cairn {
@@ -80,10 +81,37 @@ struct ExactLcpResult {
   int friction_iterations = 0; // passes run (1 without friction rows)
 };
 
-// Solves the rows' LCP exactly, writes rows[i].lambda (the entry value is
-// not used as a guess) and sets the velocities to v* + M^-1 J^T lambda.
-// The residual is lcpResidual(rows, bodies, ResidualNorm::Max) afterwards.
-// O(n^2) memory, O(n^3) time: for a few hundred rows at most.
+// The solver with its workspace (the dense problem, the factor of the
+// clamped set, the pass's and the Newton step's vectors) kept from solve to
+// solve: once it has solved a problem of a size, another of that size
+// allocates nothing (the step's exact islands, every substep). The same
+// arithmetic as a fresh solver, so the same answer to the bit.
+class ExactLcpSolver {
+ public:
+  ExactLcpSolver();
+  ~ExactLcpSolver();
+  ExactLcpSolver(ExactLcpSolver&&) noexcept;
+  ExactLcpSolver& operator=(ExactLcpSolver&&) noexcept;
+
+  // Solves the rows' LCP exactly, writes rows[i].lambda (the entry value
+  // is not used as a guess) and sets the velocities to
+  // v* + M^-1 J^T lambda. The residual is lcpResidual(rows, bodies,
+  // ResidualNorm::Max) afterwards. O(n^2) memory, O(n^3) time: for a few
+  // hundred rows at most.
+  ExactLcpResult solve(std::span<ConstraintRow> rows, std::span<SolverBody> bodies,
+                       const ExactLcpOptions& options = {});
+  // solveLcpExactDense's problem (below); the answer stays valid until the
+  // next solve.
+  const Eigen::VectorXd& solveDense(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& lo,
+                                    const Eigen::VectorXd& hi, std::span<const int> findex,
+                                    const ExactLcpOptions& options = {}, ExactLcpResult* result = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// ExactLcpSolver::solve with a solver of its own.
 ExactLcpResult solveLcpExact(std::span<ConstraintRow> rows, std::span<SolverBody> bodies,
                              const ExactLcpOptions& options = {});
 

@@ -176,7 +176,7 @@ void solveConstraints(WorldImpl& w, StepContext& ctx) {
       other_iterations = std::max(other_iterations, st.outer_iterations);
     } else {
       // Dantzig pivoting to the exact mixed-LCP solution (small islands).
-      const ExactLcpResult st = solveLcpExact(rows, v);
+      const ExactLcpResult st = w.exact_solver_.solve(rows, v);
       other_iterations = std::max(other_iterations, st.pivots);
     }
     if (s.compute_residual) residual = std::max(residual, lcpResidual(rows, v));

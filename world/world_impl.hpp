@@ -23,6 +23,7 @@
 #include "dynamics/body.hpp"
 #include "solver/direct_solver.hpp"
 #include "solver/graph_solver.hpp"
+#include "solver/lcp_exact.hpp"
 #include "solver/pgs.hpp"
 #include "solver/solver_body.hpp"
 #include "solver/worker_pool.hpp"
@@ -400,6 +401,7 @@ class WorldImpl {
   StepContext ctx_;
   DirectSolver direct_solver_;  // keeps the structure's analysis (tree order or CHOLMOD's) while it holds
   DirectSolver position_solver_;  // the joint position pass's own (its rows' pattern differs)
+  ExactLcpSolver exact_solver_;   // keeps its workspace: a steady exact island allocates nothing
   std::unique_ptr<WorkerPool> pool_;  // the step's threads; null: the calling thread alone
   // The pool set aside while its threads were found sharing their cores
   // with other work (world/pool_watch.hpp: for how many steps).

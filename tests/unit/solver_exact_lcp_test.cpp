@@ -150,6 +150,66 @@ TEST(ExactLcp, MatchesBruteForceEnumeration) {
   }
 }
 
+// ExactLcpSolver keeps its workspace from solve to solve (the step's exact
+// islands allocate nothing once warm). Whatever it solved before, its
+// answer is a fresh solver's, bit for bit: problems of 12, 5 and 12 rows
+// (bounded, unbounded, friction coupled to a normal, a singular pair that
+// forces the regularized restart) solved in turn by one solver and each by
+// a new one, the answers and every figure of the results compared with ==.
+TEST(ExactLcp, ReusedSolverGivesAFreshSolversAnswerBitForBit) {
+  std::mt19937 rng(36);
+  struct Dense {
+    Eigen::MatrixXd a;
+    Eigen::VectorXd b, lo, hi;
+    std::vector<int> findex;
+  };
+  const auto make = [&](int n, bool singular) {
+    Dense d;
+    Eigen::MatrixXd g(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) g(i, j) = uniform(rng, -1, 1);
+    if (singular) g.row(n - 1) = g.row(0);  // two equal rows: A singular without cfm
+    d.a = g * g.transpose();
+    d.b.resize(n);
+    d.lo.resize(n);
+    d.hi.resize(n);
+    d.findex.assign(static_cast<std::size_t>(n), -1);
+    for (int i = 0; i < n; ++i) {
+      d.b(i) = uniform(rng, -2, 2);
+      d.lo(i) = i % 3 == 0 ? -kInf : 0;
+      d.hi(i) = kInf;
+      if (i % 4 == 3) {  // friction on the row before: hi carries mu
+        d.findex[static_cast<std::size_t>(i)] = i - 1;
+        d.hi(i) = 0.5;
+      }
+    }
+    if (singular) {  // the copy unbounded like row 0: both are clamped, the second dependent
+      d.findex[static_cast<std::size_t>(n - 1)] = -1;
+      d.lo(n - 1) = -kInf;
+      d.hi(n - 1) = kInf;
+    }
+    return d;
+  };
+  const Dense problems[] = {make(12, false), make(5, true), make(12, true), make(12, false)};
+  ExactLcpSolver reused;
+  int restarts = 0;
+  for (const Dense& d : problems) {
+    ExactLcpResult again, fresh;
+    const Eigen::VectorXd x_again = reused.solveDense(d.a, d.b, d.lo, d.hi, d.findex, {}, &again);
+    ExactLcpSolver other;
+    const Eigen::VectorXd x_fresh = other.solveDense(d.a, d.b, d.lo, d.hi, d.findex, {}, &fresh);
+    ASSERT_EQ(x_again.size(), x_fresh.size());
+    for (Eigen::Index i = 0; i < x_again.size(); ++i) EXPECT_EQ(x_again(i), x_fresh(i)) << i;
+    EXPECT_EQ(again.converged, fresh.converged);
+    EXPECT_EQ(again.pivots, fresh.pivots);
+    EXPECT_EQ(again.residual, fresh.residual);
+    EXPECT_EQ(again.regularized, fresh.regularized);
+    EXPECT_EQ(again.friction_iterations, fresh.friction_iterations);
+    restarts += fresh.regularized ? 1 : 0;
+  }
+  EXPECT_GT(restarts, 0);  // the restart's storage was exercised too
+}
+
 // Bodies resting on the ground at three points each, sliding sideways:
 // some friction rows stick, some slide at mu lambda_n. The bounds must hold
 // for the final normal impulses, which ODE's single pass does not promise

@@ -96,5 +96,17 @@ TEST(StepAllocations, DirectChainWithItsPositionPassAllocatesNothingAfterWarmUp)
             0);
 }
 
+// A box 100 times heavier than the one it rests on goes to the exact LCP
+// solver (Dantzig's pivoting, a Newton step on the friction coupling),
+// whose dense problem, factor and vectors are kept from step to step.
+TEST(StepAllocations, ExactMassRatioStackAllocatesNothingAfterWarmUp) {
+  if (!CAIRN_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocations are ASan's in this build";
+  EXPECT_EQ(allocationsAfterWarmUp(scenarios::massRatio(100), 60, 60,
+                                   [](const World& w) {
+                                     EXPECT_EQ(w.lastStepStats().islands_by_method[static_cast<int>(SolverMethod::LCP)], 1);
+                                   }),
+            0);
+}
+
 }  // namespace
 }  // namespace cairn

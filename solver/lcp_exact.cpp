@@ -421,7 +421,7 @@ struct LcpWorkspace {
   Eigen::PartialPivLU<MatrixXd> lu;
   std::vector<RowState> sets, next_sets;
   std::vector<int> normal;  // solveDense's friction rows
-  VectorXd mu, lo, hi, x;   // solveDense's bounds and its answer
+  VectorXd mu, lo, hi;      // solveDense's coefficients and bounds
 };
 
 // w := A x + b, as (A x)_i + b_i.

@@ -41,7 +41,7 @@ class WorkerPool {
   // follows one with a loop handed over: a step's loops come tens of
   // microseconds to milliseconds apart, the spin-then-sleep wait below
   // outlasts only the shortest gaps, and each loop after a longer one paid
-  // a worker's wake-up (docs/performance.md, "Now: a warm pool"). Between
+  // a worker's wake-up (docs/performance.md, "Earlier: a warm pool"). Between
   // steps the workers go back to the bounded wait and sleep.
   void keepWarm(bool on);
   // Loops handed to the workers since the last call (parallelFor calls

@@ -25,7 +25,7 @@ namespace cairn::detail {
 // waits for a worker's wake-up: at 512, pile-1000's awake steps (1,000
 // pairs, recycled) collided in 0.28 ms against 0.35 at 1,024, and
 // pyramid-20's awake collide was unchanged (0.156 to 0.163 ms against
-// 0.157 to 0.164; docs/performance.md, "Now: a warm pool").
+// 0.157 to 0.164; docs/performance.md, "Earlier: a warm pool").
 constexpr int kParallelPairs = 512;
 
 // Moved proxies below which the broadphase's pair queries (one tree

@@ -33,7 +33,7 @@ class DiagnosticIndex {
   std::int32_t find(const std::vector<Diagnostic>& records, std::int32_t body, const char* kind) {
     if (!valid_) rebuild(records);
     const std::vector<std::int32_t>* slots = slotsOf(kind);
-    const auto slot = static_cast<size_t>(body) + 1;
+    const auto slot = static_cast<size_t>(body + 1);  // body >= -1
     if (!slots || slot >= slots->size()) return -1;
     return (*slots)[slot] - 1;
   }
@@ -41,7 +41,7 @@ class DiagnosticIndex {
   void add(std::int32_t body, const std::string& kind, std::int32_t position) {
     std::vector<std::int32_t>* slots = slotsOf(kind.c_str());
     if (!slots) slots = &kinds_.emplace_back(kind, std::vector<std::int32_t>{}).second;
-    const auto slot = static_cast<size_t>(body) + 1;
+    const auto slot = static_cast<size_t>(body + 1);  // body >= -1
     if (slot >= slots->size()) slots->resize(slot + 1, 0);
     (*slots)[slot] = position + 1;
   }

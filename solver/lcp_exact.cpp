@@ -147,6 +147,13 @@ struct Problem {
   int max_pivots = 0;
 };
 
+// w := A x + b, as (A x)_i + b_i (the product into w, then b: the order
+// Eigen gave A x + b, without its temporary).
+void residualVelocity(const MatrixXd& a, const VectorXd& b, const VectorXd& x, VectorXd& w) {
+  w.noalias() = a * x;
+  w += b;
+}
+
 // A pass's storage, kept by the solver's workspace from solve to solve.
 struct PassScratch {
   ClampedFactor factor;
@@ -285,8 +292,7 @@ class DantzigPass {
   PassStatus drive(int d, int& pivots) {
     VectorXd& w = w_;
     VectorXd& dw = dw_;
-    w.noalias() = a_ * x;  // (A x)_i, then + b_i: the sum's order
-    w += b_;
+    residualVelocity(a_, b_, x, w);
     for (;;) {
       if (++pivots > pb_.max_pivots) return PassStatus::Failed;
       if (w(d) == 0 && lo(d) < x(d) && x(d) < hi(d)) return addToClamped(d) ? PassStatus::Ok : PassStatus::Singular;
@@ -391,8 +397,7 @@ class DantzigPass {
       }
       // Keep w exact between pivots of a long drive.
       refineClamped();
-      w.noalias() = a_ * x;
-      w += b_;
+      residualVelocity(a_, b_, x, w);
     }
   }
 
@@ -423,12 +428,6 @@ struct LcpWorkspace {
   std::vector<int> normal;  // solveDense's friction rows
   VectorXd mu, lo, hi;      // solveDense's coefficients and bounds
 };
-
-// w := A x + b, as (A x)_i + b_i.
-void residualVelocity(const MatrixXd& a, const VectorXd& b, const VectorXd& x, VectorXd& w) {
-  w.noalias() = a * x;
-  w += b;
-}
 
 // max_i |F_i| of the natural map with w = A x + b and the friction bounds
 // implied by x itself (the coupled problem's residual).
@@ -679,7 +678,7 @@ void solveCore(const MatrixXd& a, const VectorXd& b, const VectorXd& lo, const V
     }
     if (!singular || attempt == 1) break;
   }
-  if (!have_best || best.size() != n || !best.allFinite()) {
+  if (!have_best || !best.allFinite()) {
     best.setZero(n);
     res.converged = false;
   }

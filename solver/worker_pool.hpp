@@ -44,6 +44,8 @@ class WorkerPool {
   // a worker's wake-up (docs/performance.md, "Earlier: a warm pool"). Between
   // steps the workers go back to the bounded wait and sleep.
   void keepWarm(bool on);
+  // Loops handed to the workers since takeLoops was last called.
+  std::int64_t loops() const { return loops_; }
   // Loops handed to the workers since the last call (parallelFor calls
   // with more than one chunk); starts the count again.
   std::int64_t takeLoops() {

@@ -64,11 +64,12 @@ Measured runOnce(BenchEngine e, const SceneDesc& scene, const OracleOptions& ora
   };
   if (e == BenchEngine::Cairn) {
     CairnRunner runner(scene, spec, m.run);
-    int alone = 0, steps = 0;  // steps on fewer threads than asked
+    std::array<int, kAloneReasonCount> alone{};  // steps on fewer threads than asked, by reason
+    int steps = 0;
     for (int s = 1; s <= scene.steps && runner.step(s); ++s) {
       const StepReading r = readLastStep(runner.world());
       ++steps;
-      if (r.threads < scene.solver.threads) ++alone;
+      if (r.threads < scene.solver.threads) ++alone[size_t(r.alone_because)];
       for (int k = 0; k < kStageCount; ++k) m.stage_seconds[size_t(k)] += r.stage_seconds[size_t(k)];
       m.rows += r.rows;
       m.contacts += r.contacts;
@@ -77,10 +78,17 @@ Measured runOnce(BenchEngine e, const SceneDesc& scene, const OracleOptions& ora
       thin(s - 1);
     }
     // A time on fewer threads than the table says must show.
-    if (alone > 0)
-      m.notes.push_back(std::to_string(alone) + " of " + std::to_string(steps) +
-                        " steps on one thread, not " + std::to_string(scene.solver.threads) +
-                        ": the worker threads were losing their cores to other work (StepStats::threads)");
+    const auto note = [&](int n, const std::string& why) {
+      if (n > 0)
+        m.notes.push_back(std::to_string(n) + " of " + std::to_string(steps) + " steps on one thread, not " +
+                          std::to_string(scene.solver.threads) + ": " + why);
+    };
+    note(alone[size_t(AloneReason::LostCores)],
+         "the worker threads were losing their cores to other work (StepStats::threads)");
+    note(alone[size_t(AloneReason::Probe)] + alone[size_t(AloneReason::NoGain)],
+         std::to_string(alone[size_t(AloneReason::Probe)]) + " timed against steps on the threads, " +
+             std::to_string(alone[size_t(AloneReason::NoGain)]) +
+             " because steps alone were found faster (StepStats::alone_because)");
   } else {
     BulletRunner runner(scene, spec, m.run, oracle);
     for (int s = 1; s <= scene.steps && runner.step(s); ++s) thin(s - 1);

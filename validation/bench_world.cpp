@@ -13,6 +13,7 @@ StepReading readLastStep(const World& world) {
   r.contact_points = s.contact_points;
   r.sleeping_bodies = s.sleeping_bodies;
   r.threads = s.threads;
+  r.alone_because = s.alone_because;
   return r;
 }
 

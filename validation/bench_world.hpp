@@ -21,6 +21,7 @@ struct StepReading {
   int contact_points = 0;
   int sleeping_bodies = 0;
   int threads = 1;         // threads the step ran on (StepStats::threads)
+  AloneReason alone_because = AloneReason::None;  // why on one when asked for more (StepStats::alone_because)
 };
 
 // The last step's statistics (World::lastStepStats()).

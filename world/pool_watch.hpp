@@ -1,19 +1,42 @@
-// When the step sets its worker pool aside: the rule, apart from the
-// threads and clocks that feed it, so that it can be followed step by step.
+// When the step sets its worker pool aside: the rules, apart from the
+// threads and clocks that feed them, so that they can be followed step by
+// step. Results do not depend on the thread count
+// (tests/unit/solver_determinism_test.cpp), so neither do they on these.
 //
-// A pool whose threads lose their cores to other work in a step
-// (WorkerPool::takePreemptedWaits) runs the step slower than one thread:
-// its loops hand work between threads every few microseconds, and each
-// handover waits for a thread that is not running. So after a step with
-// kPreemptedPerStep such waits the pool is set aside and the world steps
-// on the calling thread alone for kSoloFirst steps, twice as many each
-// time the pool is found sharing its cores again (up to kSoloMost), then
-// takes it back to try. A step on the pool not found sharing starts the
-// lengths again at kSoloFirst. Results do not depend on the thread count
-// (tests/unit/solver_determinism_test.cpp), so neither do they on this.
+// Lost cores. A pool whose threads lose their cores to other work in a
+// step (WorkerPool::takePreemptedWaits) runs the step slower than one
+// thread: its loops hand work between threads every few microseconds, and
+// each handover waits for a thread that is not running. So after a step
+// with kPreemptedPerStep such waits the pool is set aside and the world
+// steps on the calling thread alone for kSoloFirst steps, twice as many
+// each time the pool is found sharing its cores again (up to kSoloMost),
+// then takes it back to try. A step on the pool not found sharing starts
+// the lengths again at kSoloFirst.
+//
+// No gain. Two cores of their own can still make a step slower than one:
+// each handover moves the bodies' and rows' cache lines between the
+// cores, and what that costs is the machine's (on one 2-CPU virtual
+// machine an awake pyramid-20 stepped 1.15 to 1.2 times slower on two
+// threads than on one, docs/performance.md). So the watch measures the
+// pool's gain on the scene as it runs: after kProbeFirst steps that
+// handed the pool a loop, it steps kSample steps alone (a probe) and
+// compares their wall time with that of the kSample pool steps before.
+// Where the steps alone took less than kSoloBetter of the pool's time, the
+// pool sits out kNoGainFirst steps, twice as many each time it is found
+// not paying again (up to kNoGainMost), and is judged again on its
+// kSample steps after each return. Where it pays, the next probe comes
+// four times as many steps later (up to kProbeMost): a probe's steps alone
+// are what the rule costs a scene whose pool pays (two probes, 8 of the
+// 5,050-box pyramid's first 100 steps). Steps are compared only
+// when they did about the same work (rows within kSameWork of each other),
+// the pool's only when it was handed a loop, and never the first step on
+// a pool back from sitting out (its workers wake from sleep).
 #pragma once
 
+#include "cairn/stats.hpp"
+
 #include <algorithm>
+#include <array>
 #include <cstdint>
 
 namespace cairn {
@@ -23,6 +46,13 @@ class PoolWatch {
   static constexpr std::int64_t kPreemptedPerStep = 8;
   static constexpr int kSoloFirst = 16;
   static constexpr int kSoloMost = 1024;
+  static constexpr int kSample = 4;
+  static constexpr int kProbeFirst = 8;
+  static constexpr int kProbeMost = 1024;
+  static constexpr int kNoGainFirst = 16;
+  static constexpr int kNoGainMost = 256;
+  static constexpr double kSoloBetter = 0.97;
+  static constexpr double kSameWork = 1.1;
 
   // Before a step: whether it runs on the pool (false: on the calling
   // thread alone, one of the steps sat out).
@@ -32,24 +62,112 @@ class PoolWatch {
     return false;
   }
 
-  // After a step on the pool, given the waits in it that lost their core:
-  // whether the pool is set aside from the next step on.
-  bool endPoolStep(std::int64_t preempted_waits) {
-    if (preempted_waits < kPreemptedPerStep) {
-      solo_length_ = kSoloFirst;
+  // After a step on the pool, given the waits in it that lost their core,
+  // whether a loop was handed to the pool, the step's wall time and its
+  // work (rows): whether the pool is set aside from the next step on.
+  bool endPoolStep(std::int64_t preempted_waits, bool handed = false, double seconds = 0, int work = 0) {
+    if (preempted_waits >= kPreemptedPerStep) {
+      solo_steps_ = solo_length_;
+      solo_length_ = std::min(2 * solo_length_, kSoloMost);
+      aside_ = AloneReason::LostCores;
+      pool_count_ = 0;
+      judging_ = false;
+      wake_ = true;
+      return true;
+    }
+    solo_length_ = kSoloFirst;
+    aside_ = AloneReason::None;
+    if (!handed) return false;  // a step that hands nothing says nothing about the pool's gain
+    if (wake_) {
+      wake_ = false;
       return false;
     }
-    solo_steps_ = solo_length_;
-    solo_length_ = std::min(2 * solo_length_, kSoloMost);
+    pool_[static_cast<size_t>(pool_count_++ % kSample)] = {seconds, work};
+    if (pool_count_ < kSample) return false;
+    if (judging_) {
+      judging_ = false;
+      if (soloBetter()) return setAsideForNoGain();
+      no_gain_length_ = kNoGainFirst;
+      probe_every_ = kProbeFirst;
+      to_probe_ = probe_every_;
+      return false;
+    }
+    if (--to_probe_ > 0) return false;
+    solo_steps_ = kSample;
+    solo_count_ = 0;
+    aside_ = AloneReason::Probe;
     return true;
   }
 
-  // A pool made anew (another thread count): the lengths start again.
+  // After a step alone: its wall time and work. The pool comes back at
+  // the next startStep unless this ends a probe that found no gain.
+  void endSoloStep(double seconds, int work) {
+    if (aside_ == AloneReason::LostCores || aside_ == AloneReason::None) return;  // shared cores' times say nothing
+    solo_[static_cast<size_t>(solo_count_++ % kSample)] = {seconds, work};
+    if (solo_steps_ > 0) return;
+    if (aside_ == AloneReason::Probe && solo_count_ >= kSample && soloBetter()) {
+      setAsideForNoGain();
+      return;
+    }
+    if (aside_ == AloneReason::Probe) {
+      probe_every_ = std::min(4 * probe_every_, kProbeMost);
+      to_probe_ = probe_every_;
+    } else {
+      judging_ = true;
+    }
+    pool_count_ = 0;
+    wake_ = true;
+    aside_ = AloneReason::None;
+  }
+
+  // Why the steps alone run alone now (None while on the pool).
+  AloneReason aside() const { return aside_; }
+
+  // A pool made anew (another thread count): everything starts again.
   void reset() { *this = PoolWatch{}; }
 
  private:
+  struct Sample {
+    double seconds = 0;
+    int work = 0;
+  };
+
+  // Whether the last kSample steps alone took less than kSoloBetter of the
+  // last kSample pool steps' time, all of them about the same work.
+  bool soloBetter() const {
+    if (pool_count_ < kSample || solo_count_ < kSample) return false;
+    int least = pool_[0].work, most = pool_[0].work;
+    double pool = 0, solo = 0;
+    for (int k = 0; k < kSample; ++k) {
+      const Sample& p = pool_[static_cast<size_t>(k)];
+      const Sample& s = solo_[static_cast<size_t>(k)];
+      least = std::min({least, p.work, s.work});
+      most = std::max({most, p.work, s.work});
+      pool += p.seconds;
+      solo += s.seconds;
+    }
+    if (double(most) > kSameWork * double(least)) return false;
+    return solo < kSoloBetter * pool;
+  }
+
+  bool setAsideForNoGain() {
+    solo_steps_ = no_gain_length_;
+    no_gain_length_ = std::min(2 * no_gain_length_, kNoGainMost);
+    solo_count_ = 0;
+    aside_ = AloneReason::NoGain;
+    return true;
+  }
+
   int solo_steps_ = 0;            // steps still to sit out
-  int solo_length_ = kSoloFirst;  // the next run alone, when the pool is set aside again
+  int solo_length_ = kSoloFirst;  // the next run alone, when the pool is found sharing again
+  AloneReason aside_ = AloneReason::None;
+  std::array<Sample, kSample> pool_{}, solo_{};  // the latest steps on the pool and alone, as rings
+  int pool_count_ = 0, solo_count_ = 0;          // samples taken since the rings were last emptied
+  int probe_every_ = kProbeFirst;                // pool steps from one probe to the next
+  int to_probe_ = kProbeFirst;                   // pool steps until the next probe
+  int no_gain_length_ = kNoGainFirst;            // the next run alone, when the pool is found not paying
+  bool judging_ = false;                         // back from a run alone for no gain: judge the pool again
+  bool wake_ = false;                            // the next pool step is its workers' wake-up
 };
 
 }  // namespace cairn

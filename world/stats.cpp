@@ -31,4 +31,15 @@ const char* methodReasonName(MethodReason r) {
   return "unknown";
 }
 
+const char* aloneReasonName(AloneReason r) {
+  switch (r) {
+    case AloneReason::None: return "none";
+    case AloneReason::LostCores: return "lost_cores";
+    case AloneReason::Probe: return "probe";
+    case AloneReason::NoGain: return "no_gain";
+    case AloneReason::Count: break;
+  }
+  return "unknown";
+}
+
 }  // namespace cairn

@@ -73,7 +73,8 @@ void clearForces(WorldImpl& w, const StepContext& ctx) {
 }
 
 // The worker pool follows SolverSettings::threads, less the steps it sits
-// out after its threads were found sharing their cores (world/pool_watch.hpp).
+// out after its threads were found sharing their cores or not paying
+// (world/pool_watch.hpp).
 void fitPool(WorldImpl& w) {
   const int threads = w.settings_.threads;
   if (threads <= 1) {
@@ -92,11 +93,20 @@ void fitPool(WorldImpl& w) {
   }
 }
 
-// After the step: sets the pool aside when its threads lost their cores.
-void watchPool(WorldImpl& w) {
-  if (!w.pool_) return;
+// After the step, given its wall time so far: sets the pool aside when its
+// threads lost their cores or when steps alone ran faster
+// (world/pool_watch.hpp), and says why this step ran alone.
+void watchPool(WorldImpl& w, double seconds) {
+  if (!w.pool_) {
+    if (!w.parked_pool_) return;
+    w.stats_.alone_because = w.pool_watch_.aside();
+    w.pool_watch_.endSoloStep(seconds, w.stats_.rows);
+    return;
+  }
   const std::int64_t preempted = w.pool_->takePreemptedWaits();
-  if (w.pool_watch_.endPoolStep(w.watch_pool_ ? preempted : 0)) w.parked_pool_ = std::move(w.pool_);
+  const bool handed = w.pool_->loops() > 0;
+  if (w.watch_pool_ && w.pool_watch_.endPoolStep(preempted, handed, seconds, w.stats_.rows))
+    w.parked_pool_ = std::move(w.pool_);
 }
 
 // Keeps the pool's workers waiting warm through the step (solver/worker_pool.hpp)
@@ -197,7 +207,7 @@ void WorldImpl::step(Real h) {
   saveStepEnd(*this, ctx);
   stats_.islands = ctx.island_count;
   stats_.threads = pool_ ? pool_->threads() : 1;
-  watchPool(*this);
+  watchPool(*this, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   clock.lap(Stage::Guards);
   ++step_count_;
   time_ += h;

@@ -53,6 +53,18 @@ inline constexpr int kMethodReasonCount = static_cast<int>(MethodReason::Count);
 const char* methodReasonName(MethodReason r);  ///< lower-case name
 inline constexpr int kSolverMethodCount = 4;  ///< SolverMethod's PGS, Direct, LCP, Auto
 
+/// Why a step asked to run on worker threads ran on the calling thread
+/// alone (world/pool_watch.hpp; docs/performance.md, "Threads").
+enum class AloneReason : std::uint8_t {
+  None,       ///< it ran on its threads, or was asked for one
+  LostCores,  ///< its threads were losing their cores to other work
+  Probe,      ///< the World timed steps alone against steps on its threads
+  NoGain,     ///< steps alone were found faster than steps on its threads
+  Count
+};
+inline constexpr int kAloneReasonCount = static_cast<int>(AloneReason::Count);  ///< number of reasons
+const char* aloneReasonName(AloneReason r);  ///< lower-case name
+
 /// What the last step reports (World::lastStepStats).
 struct StepStats {
   int iterations = 0;        ///< PGS sweeps done (summed over substeps)
@@ -62,7 +74,8 @@ struct StepStats {
   int contact_points = 0;    ///< points of the touching manifolds
   int recycled_contacts = 0; ///< manifolds kept without a narrowphase run (SolverSettings::recycle_distance)
   int islands = 0;           ///< awake islands solved
-  int threads = 1;           ///< threads the step ran on: SolverSettings::threads, or 1 while the worker threads sit out steps after losing their cores to other work (docs/performance.md, "Threads")
+  int threads = 1;           ///< threads the step ran on: SolverSettings::threads, or 1 while the worker threads sit out steps (alone_because)
+  AloneReason alone_because = AloneReason::None;  ///< why a step asked to use threads ran on one
   int sleeping_bodies = 0;   ///< bodies asleep after the step
   double max_penetration = 0;  ///< deepest contact after the step (m)
   double energy = 0;           ///< kinetic + potential (gravity, springs) after the step (J)

@@ -1,7 +1,8 @@
-// The rule by which a World sets its worker pool aside while the pool's
-// threads lose their cores to other work (world/pool_watch.hpp), followed
-// step by step with the lost waits given: the same rule the real scheduler
-// feeds in tests/unit/solver_determinism_test.cpp.
+// The rules by which a World sets its worker pool aside while the pool's
+// threads lose their cores to other work, or while steps alone run faster
+// (world/pool_watch.hpp), followed step by step with the lost waits and
+// the steps' times given: the same rules the real scheduler and clock feed
+// in tests/unit/solver_determinism_test.cpp.
 #include "world/pool_watch.hpp"
 
 #include <gtest/gtest.h>
@@ -63,6 +64,119 @@ TEST(PoolWatch, ANewPoolStartsTheLengthsAgain) {
   runsAlone(watch, 1 + 16 + 1 + 32 + 1, [](int) { return PoolWatch::kPreemptedPerStep; });  // the next run: 64
   watch.reset();
   EXPECT_EQ(runsAlone(watch, 1 + 16 + 1, [](int) { return PoolWatch::kPreemptedPerStep; }), std::vector<int>{16});
+}
+
+// A machine where a step takes `pool` seconds on the pool and `alone`
+// seconds alone, every step the same work and handing the pool a loop.
+// Returns the runs alone as (first step, length, reason), step counting
+// from 0.
+struct RunAlone {
+  int first, length;
+  AloneReason why;
+  bool operator==(const RunAlone&) const = default;
+};
+std::vector<RunAlone> timedRuns(PoolWatch& watch, int steps, double pool, double alone, int work = 100,
+                                bool handed = true, int other_work_from = -1) {
+  std::vector<RunAlone> runs;
+  for (int s = 0; s < steps; ++s) {
+    const int w = other_work_from >= 0 && s >= other_work_from ? 2 * work : work;
+    if (watch.startStep()) {
+      watch.endPoolStep(0, handed, pool, w);
+      continue;
+    }
+    const AloneReason why = watch.aside();
+    if (runs.empty() || runs.back().first + runs.back().length != s || runs.back().why != why)
+      runs.push_back({s, 0, why});
+    ++runs.back().length;
+    watch.endSoloStep(alone, w);
+  }
+  return runs;
+}
+
+// Steps alone 20% faster than on the pool: the first probe comes after the
+// ring's 4 pool steps and kProbeFirst more; it finds no gain, so the pool
+// sits out 16 steps, comes back (a wake-up step, 4 steps judged), is found
+// not paying again and sits out twice as long, up to 256.
+TEST(PoolWatch, AloneFasterSetsThePoolAsideForLongerEachTime) {
+  constexpr int kProbe = 3 + PoolWatch::kProbeFirst;  // pool steps 0, 1, 2 fill the ring with the first decrement's
+  PoolWatch watch;
+  const std::vector<RunAlone> runs = timedRuns(watch, 700, 1.2, 1.0);
+  std::vector<RunAlone> expected{{kProbe, 4, AloneReason::Probe}, {kProbe + 4, 16, AloneReason::NoGain}};
+  int at = kProbe + 20;
+  for (const int length : {32, 64, 128, 256, 256}) {
+    at += 5;  // the wake-up step and 4 judged
+    if (at >= 700) break;
+    expected.push_back({at, std::min(length, 700 - at), AloneReason::NoGain});
+    at += length;
+  }
+  EXPECT_EQ(runs, expected);
+}
+
+// The pool 20% faster: each probe of 4 steps finds it paying, and the next
+// comes four times as many pool steps later (a wake-up step, 4 to fill the
+// ring again, then the interval), up to kProbeMost.
+TEST(PoolWatch, ThePoolPayingIsProbedFourTimesAsRarelyEachTime) {
+  constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
+  PoolWatch watch;
+  const std::vector<RunAlone> runs = timedRuns(watch, 3000, 0.8, 1.0);
+  std::vector<RunAlone> expected{{kProbe, 4, AloneReason::Probe}};
+  int at = kProbe + 4;
+  for (int every = 4 * PoolWatch::kProbeFirst;; every = std::min(4 * every, PoolWatch::kProbeMost)) {
+    at += 1 + 3 + every;
+    if (at >= 3000) break;
+    expected.push_back({at, 4, AloneReason::Probe});
+    at += 4;
+  }
+  EXPECT_EQ(runs, expected);
+  EXPECT_EQ(runs.back().first - runs[runs.size() - 2].first, 4 + 1 + 3 + PoolWatch::kProbeMost);
+}
+
+// Alone within 3% of the pool (kSoloBetter): the pool stays.
+TEST(PoolWatch, AloneBarelyFasterKeepsThePool) {
+  PoolWatch watch;
+  for (const RunAlone& r : timedRuns(watch, 600, 1.0, 0.98)) EXPECT_EQ(r.why, AloneReason::Probe);
+}
+
+// Steps that hand the pool nothing never lead to a probe; nor does a probe
+// whose steps did twice the work of the pool's steps give a verdict (the
+// work doubles at the probe's first step): the pool comes back until the
+// next probe, 1 + 3 + 4 kProbeFirst pool steps later.
+TEST(PoolWatch, StepsHandingNothingOrOfOtherWorkGiveNoVerdict) {
+  constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
+  PoolWatch watch;
+  EXPECT_TRUE(timedRuns(watch, 500, 1.2, 1.0, 100, false).empty());
+  watch.reset();
+  const int next_probe = kProbe + 4 + 1 + 3 + 4 * PoolWatch::kProbeFirst;
+  EXPECT_EQ(timedRuns(watch, next_probe, 1.2, 1.0, 100, true, kProbe),
+            (std::vector<RunAlone>{{kProbe, 4, AloneReason::Probe}}));
+}
+
+// Lost cores while the pool is judged: the lost cores' rule takes over,
+// and steps on shared cores are not sampled.
+TEST(PoolWatch, LostCoresTakeOverFromAProbe) {
+  PoolWatch watch;
+  for (int s = 0; s < 3 + PoolWatch::kProbeFirst; ++s) {
+    ASSERT_TRUE(watch.startStep());
+    watch.endPoolStep(0, true, 1.2, 100);
+  }
+  for (int s = 0; s < 4; ++s) {  // the probe, alone faster: no gain
+    ASSERT_FALSE(watch.startStep());
+    EXPECT_EQ(watch.aside(), AloneReason::Probe);
+    watch.endSoloStep(1.0, 100);
+  }
+  EXPECT_EQ(watch.aside(), AloneReason::NoGain);
+  for (int s = 0; s < 16; ++s) {
+    ASSERT_FALSE(watch.startStep());
+    watch.endSoloStep(1.0, 100);
+  }
+  ASSERT_TRUE(watch.startStep());
+  EXPECT_TRUE(watch.endPoolStep(PoolWatch::kPreemptedPerStep, true, 1.2, 100));
+  EXPECT_EQ(watch.aside(), AloneReason::LostCores);
+  for (int s = 0; s < PoolWatch::kSoloFirst; ++s) {
+    ASSERT_FALSE(watch.startStep());
+    watch.endSoloStep(1.0, 100);
+  }
+  EXPECT_TRUE(watch.startStep());
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 
 namespace cairn::validation {
 
@@ -54,50 +55,84 @@ struct Measured {
   std::vector<std::string> notes;
 };
 
-// One run of `scene` in configuration `e`, stepped to the end or until it stops.
-Measured runOnce(BenchEngine e, const SceneDesc& scene, const OracleOptions& oracle, const ValidationSpec& spec,
-                 bool keep_every_sample) {
-  Measured m;
-  const int keep_from = keep_every_sample ? 0 : lastSecondStart(scene);
-  const auto thin = [&](int s) {
-    if (s > 0 && s < keep_from && s < m.run.samples()) thinSample(m.run, s);
-  };
-  if (e == BenchEngine::Cairn) {
-    CairnRunner runner(scene, spec, m.run);
-    std::array<int, kAloneReasonCount> alone{};  // steps on fewer threads than asked, by reason
-    int steps = 0;
-    for (int s = 1; s <= scene.steps && runner.step(s); ++s) {
-      const StepReading r = readLastStep(runner.world());
-      ++steps;
-      if (r.threads < scene.solver.threads) ++alone[size_t(r.alone_because)];
-      for (int k = 0; k < kStageCount; ++k) m.stage_seconds[size_t(k)] += r.stage_seconds[size_t(k)];
-      m.rows += r.rows;
-      m.contacts += r.contacts;
-      m.contact_points += r.contact_points;
-      m.sleeping = r.sleeping_bodies;
-      thin(s - 1);
-    }
-    // A time on fewer threads than the table says must show.
-    const auto note = [&](int n, const std::string& why) {
-      if (n > 0)
-        m.notes.push_back(std::to_string(n) + " of " + std::to_string(steps) + " steps on one thread, not " +
-                          std::to_string(scene.solver.threads) + ": " + why);
-    };
-    note(alone[size_t(AloneReason::LostCores)],
-         "the worker threads were losing their cores to other work (StepStats::threads)");
-    note(alone[size_t(AloneReason::Probe)] + alone[size_t(AloneReason::NoGain)],
-         std::to_string(alone[size_t(AloneReason::Probe)]) + " timed against steps on the threads, " +
-             std::to_string(alone[size_t(AloneReason::NoGain)]) +
-             " because steps alone were found faster (StepStats::alone_because)");
-  } else {
-    BulletRunner runner(scene, spec, m.run, oracle);
-    for (int s = 1; s <= scene.steps && runner.step(s); ++s) thin(s - 1);
-    m.sleeping = runner.sleepingBodies();
-    m.notes = runner.skipped();
+// One run of `scene` in configuration `e`, stepped a turn at a time
+// (runBenchScene hands the three configurations the machine in turns) to
+// the end or until it stops. Its runner writes into its own Measured, so
+// it stays where it was made.
+class TurnRun {
+ public:
+  TurnRun(BenchEngine e, const SceneDesc& scene, const OracleOptions& oracle, const ValidationSpec& spec,
+          bool keep_every_sample)
+      : engine_(e), scene_(scene), keep_from_(keep_every_sample ? 0 : lastSecondStart(scene)) {
+    if (e == BenchEngine::Cairn) cairn_ = std::make_unique<CairnRunner>(scene, spec, m_.run);
+    else bullet_ = std::make_unique<BulletRunner>(scene, spec, m_.run, oracle);
   }
-  for (size_t s = 1; s < m.run.step_seconds.size(); ++s) m.seconds += m.run.step_seconds[s];
-  return m;
-}
+  TurnRun(const TurnRun&) = delete;
+  TurnRun& operator=(const TurnRun&) = delete;
+
+  // Steps up to step `last` (1-based) unless the run has ended.
+  void stepThrough(int last) {
+    for (; running_ && next_ <= std::min(last, scene_.steps); ++next_) {
+      running_ = cairn_ ? cairn_->step(next_) : bullet_->step(next_);
+      if (!running_) break;
+      if (cairn_) readCairnStep();
+      thin(next_ - 1);
+    }
+  }
+
+  // The finished run: its time and, for cairn, a note on steps taken on
+  // fewer threads than asked.
+  Measured finish() {
+    if (cairn_) {  // a time on fewer threads than the table says must show
+      const auto note = [&](int alone, const std::string& why) {
+        if (alone > 0)
+          m_.notes.push_back(std::to_string(alone) + " of " + std::to_string(steps_) + " steps on one thread, not " +
+                             std::to_string(scene_.solver.threads) + ": " + why);
+      };
+      note(alone_[size_t(AloneReason::LostCores)],
+           "the worker threads were losing their cores to other work (StepStats::threads)");
+      note(alone_[size_t(AloneReason::Probe)] + alone_[size_t(AloneReason::NoGain)],
+           std::to_string(alone_[size_t(AloneReason::Probe)]) + " timed against steps on the threads, " +
+               std::to_string(alone_[size_t(AloneReason::NoGain)]) +
+               " because steps alone were found faster (StepStats::alone_because)");
+    } else {
+      m_.sleeping = bullet_->sleepingBodies();
+      m_.notes = bullet_->skipped();
+    }
+    for (size_t s = 1; s < m_.run.step_seconds.size(); ++s) m_.seconds += m_.run.step_seconds[s];
+    cairn_.reset();
+    bullet_.reset();
+    return std::move(m_);
+  }
+
+  BenchEngine engine() const { return engine_; }
+
+ private:
+  void readCairnStep() {
+    const StepReading r = readLastStep(cairn_->world());
+    ++steps_;
+    if (r.threads < scene_.solver.threads) ++alone_[size_t(r.alone_because)];
+    for (int k = 0; k < kStageCount; ++k) m_.stage_seconds[size_t(k)] += r.stage_seconds[size_t(k)];
+    m_.rows += r.rows;
+    m_.contacts += r.contacts;
+    m_.contact_points += r.contact_points;
+    m_.sleeping = r.sleeping_bodies;
+  }
+  void thin(int s) {
+    if (s > 0 && s < keep_from_ && s < m_.run.samples()) thinSample(m_.run, s);
+  }
+
+  BenchEngine engine_;
+  const SceneDesc& scene_;
+  int keep_from_;
+  Measured m_;
+  std::unique_ptr<CairnRunner> cairn_;
+  std::unique_ptr<BulletRunner> bullet_;
+  int next_ = 1;
+  bool running_ = true;
+  std::array<int, kAloneReasonCount> alone_{};  // cairn: steps on fewer threads than asked, by reason
+  int steps_ = 0;                                // cairn: steps made
+};
 
 // What one run says about accuracy, plus its counts: the part of a result
 // that every repeat must reproduce exactly.
@@ -168,7 +203,7 @@ std::array<double, kStageCount> BenchEngineResult::medianStageMs() const {
 }
 
 BenchSceneResult runBenchScene(const BenchScene& scene, int repeats,
-                               const std::function<void(const std::string&)>& progress) {
+                               const std::function<void(const std::string&)>& progress, int turn_steps) {
   BenchSceneResult result;
   result.name = scene.name;
   result.family = scene.family;
@@ -187,12 +222,23 @@ BenchSceneResult runBenchScene(const BenchScene& scene, int repeats,
   const EngineRun* ruler = reference.samples() > 1 ? &reference : nullptr;
 
   std::array<Figures, kBenchEngineCount> first;
+  const int steps_asked = scene.base.steps;
+  const int turn = turn_steps > 0 ? turn_steps : std::max(1, (steps_asked + kTurnsPerRun - 1) / kTurnsPerRun);
   for (int r = 0; r < repeats; ++r) {
+    std::array<std::unique_ptr<TurnRun>, kBenchEngineCount> runs;  // in this repeat's order
     for (int k = 0; k < kBenchEngineCount; ++k) {
       const BenchEngine e = benchEngine((r + k) % kBenchEngineCount);
+      runs[size_t(k)] = std::make_unique<TurnRun>(e, scene.scenes[size_t(e)], scene.oracle[size_t(e)], spec,
+                                                  spec.direct_reference);
+    }
+    for (int from = 1; from <= steps_asked; from += turn)
+      for (auto& run : runs) run->stepThrough(from + turn - 1);
+    for (auto& run : runs) {
+      const BenchEngine e = run->engine();
       const SceneDesc& s = scene.scenes[size_t(e)];
       BenchEngineResult& out = result.engines[size_t(e)];
-      Measured m = runOnce(e, s, scene.oracle[size_t(e)], spec, spec.direct_reference);
+      Measured m = run->finish();
+      run.reset();
       if (e == BenchEngine::Cairn)  // its notes are per scene, Bullet's the same for all
         for (std::string& n : m.notes) n = scene.name + ", repeat " + std::to_string(r + 1) + ": " + n;
       const int steps = m.run.samples() - 1;

@@ -16,11 +16,24 @@
 //   bullet_matched   cairn's model mapped onto Bullet (match_cairn = true,
 //                    the scene's sleeping), as `cairn validate` runs it
 //
-// Repeat r runs the three in turn, the first being configuration r mod 3,
-// so that none always runs first (on a cold cache) or last. A run's time is
-// the sum of its steps' wall times (World::step; Bullet's step) over the
-// steps it made; the table reports the median over repeats. The runs are
-// deterministic, so the accuracy figures are those of the first repeat;
+// Each repeat builds the three runs and hands them the machine in turns of
+// a tenth of the run's steps (kTurnsPerRun): the first configuration's
+// steps 1 to 60 of 600, the second's, the third's, then every
+// configuration's steps 61 to 120, and so on. A shared virtual machine's
+// speed changes in spells (on this project's, chain-100's step took 0.056
+// or 0.077 ms from one 0.4 s run to the next); a run made in one piece,
+// 36 ms for cairn's chain-100, could fall wholly inside a slow spell that
+// the other configurations missed, and its ratio said more about the
+// machine than the engines. In turns, the configurations share the
+// spells (docs/benchmarks.md measures the spread of the per-repeat
+// ratios both ways). Each turn starts on caches the other configurations
+// used, a cost each configuration pays alike. Repeat r starts each round
+// of turns with configuration r mod 3, so none always runs first or last.
+// A run's time is the sum of its steps' wall times (World::step; Bullet's
+// step) over the steps it made; the table reports the median over
+// repeats. The runs
+// are independent worlds and deterministic, so the turns change no figure
+// (tested), the accuracy figures are those of the first repeat, and
 // later repeats are checked to give the same figures.
 //
 // Accuracy figures of a run, each engine measured by the same code through
@@ -96,9 +109,14 @@ struct BenchSceneResult {
 // The median (the mean of the middle two for an even count); NaN when empty.
 double median(std::vector<double> values);
 
+// Turns of a run (see the top of this file).
+inline constexpr int kTurnsPerRun = 10;
+
 // Runs `scene` `repeats` times in each configuration (repeats >= 1).
 // `progress` is told of each run as it finishes ("cairn 2.51 ms/step").
+// `turn_steps` > 0 sets the steps of a turn instead (the whole run: no
+// turns), for the test that the turns change no figure.
 BenchSceneResult runBenchScene(const BenchScene& scene, int repeats,
-                               const std::function<void(const std::string&)>& progress = {});
+                               const std::function<void(const std::string&)>& progress = {}, int turn_steps = 0);
 
 }  // namespace cairn::validation

@@ -347,6 +347,41 @@ TEST(BenchRun, FiguresAreThoseCairnValidateReports) {
   }
 }
 
+// The bench hands the three configurations the machine in turns
+// (bench_run.hpp); their worlds are independent, so the turns' length
+// changes no figure of any configuration: turns of 7 steps (the last one
+// short) against each run made in one piece, over two repeats (each
+// starting its turns with another configuration).
+TEST(BenchRun, TurnsChangeNoFigureOfAnyConfiguration) {
+  for (const std::string key : {"column-10", "chain-20"}) {
+    SCOPED_TRACE(key);
+    SceneDesc scene = validation::standardScene(key).scene;
+    scene.steps = 90;
+    const validation::BenchScene bench = validation::makeBenchScene(key, scene, validation::BenchOverrides{});
+    const validation::BenchSceneResult whole = validation::runBenchScene(bench, 2, {}, scene.steps);
+    const validation::BenchSceneResult turns = validation::runBenchScene(bench, 2, {}, 7);
+    for (int k = 0; k < validation::kBenchEngineCount; ++k) {
+      const validation::BenchEngine e = validation::benchEngine(k);
+      SCOPED_TRACE(validation::benchEngineName(e));
+      const validation::BenchEngineResult& a = whole[e];
+      const validation::BenchEngineResult& b = turns[e];
+      EXPECT_EQ(b.status, "ok");
+      EXPECT_EQ(a.status, b.status);
+      EXPECT_EQ(a.steps, 90);
+      EXPECT_EQ(a.steps, b.steps);
+      EXPECT_EQ(a.ms_per_step.size(), b.ms_per_step.size());
+      EXPECT_EQ(a.rows, b.rows);
+      EXPECT_EQ(a.contacts, b.contacts);
+      EXPECT_EQ(a.contact_points, b.contact_points);
+      EXPECT_EQ(a.sleeping_bodies, b.sleeping_bodies);
+      EXPECT_EQ(a.rest_displacement, b.rest_displacement);
+      EXPECT_EQ(a.penetration, b.penetration);
+      EXPECT_EQ(a.joint_error, b.joint_error);
+      EXPECT_EQ(a.exact_distance, b.exact_distance);
+    }
+  }
+}
+
 TEST(BenchPlan, OverridesReachTheEnginesTheyName) {
   const SceneDesc scene = validation::standardScene("column-3").scene;
   validation::BenchOverrides o;

@@ -16,8 +16,8 @@
 // No gain. Two cores of their own can still make a step slower than one:
 // each handover moves the bodies' and rows' cache lines between the
 // cores, and what that costs is the machine's (on one 2-CPU virtual
-// machine an awake pyramid-20 stepped 1.15 to 1.2 times slower on two
-// threads than on one, docs/performance.md). So the watch measures the
+// machine an awake pyramid-20 stepped 1.2 to 1.65 times slower on two
+// threads than on one, docs/performance.md, "Threads"). So the watch measures the
 // pool's gain on the scene as it runs: after kProbeFirst steps that
 // handed the pool a loop, it steps kSample steps alone (a probe) and
 // compares their wall time with that of the kSample pool steps before.

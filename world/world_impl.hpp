@@ -415,6 +415,9 @@ class WorldImpl {
   // false: the pool is never set aside (the tests that must run every step
   // on their threads, whatever else the machine runs).
   bool watch_pool_ = true;
+  // false: steps are not timed against steps alone, so only lost cores
+  // set the pool aside (the test of that rule under the real scheduler).
+  bool time_pool_ = true;
   std::uint64_t rng_state_ = 0;
   bool rng_seeded_ = false;
 

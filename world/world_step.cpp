@@ -104,7 +104,7 @@ void watchPool(WorldImpl& w, double seconds) {
     return;
   }
   const std::int64_t preempted = w.pool_->takePreemptedWaits();
-  const bool handed = w.pool_->loops() > 0;
+  const bool handed = w.time_pool_ && w.pool_->loops() > 0;  // a step not handed a loop is not timed
   if (w.watch_pool_ && w.pool_watch_.endPoolStep(preempted, handed, seconds, w.stats_.rows))
     w.parked_pool_ = std::move(w.pool_);
 }

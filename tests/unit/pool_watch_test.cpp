@@ -93,8 +93,9 @@ std::vector<RunAlone> timedRuns(PoolWatch& watch, int steps, double pool, double
   return runs;
 }
 
-// Steps alone 20% faster than on the pool: the first probe comes after the
-// ring's 4 pool steps and kProbeFirst more; it finds no gain, so the pool
+// Steps alone 20% faster than on the pool: the first probe comes after
+// kProbeFirst + 3 pool steps (the fourth, which fills the ring, is the
+// interval's first); it finds no gain, so the pool
 // sits out 16 steps, comes back (a wake-up step, 4 steps judged), is found
 // not paying again and sits out twice as long, up to 256.
 TEST(PoolWatch, AloneFasterSetsThePoolAsideForLongerEachTime) {
@@ -151,9 +152,11 @@ TEST(PoolWatch, StepsHandingNothingOrOfOtherWorkGiveNoVerdict) {
             (std::vector<RunAlone>{{kProbe, 4, AloneReason::Probe}}));
 }
 
-// Lost cores while the pool is judged: the lost cores' rule takes over,
-// and steps on shared cores are not sampled.
-TEST(PoolWatch, LostCoresTakeOverFromAProbe) {
+// Lost cores when the pool returns from a run alone for no gain: the lost
+// cores' rule takes over (its run of 16), and after it the gain rule starts
+// over with a probe once its ring is full again (a wake-up step, 4 pool
+// steps), not with a verdict on the old samples.
+TEST(PoolWatch, LostCoresTakeOverFromTheGainRule) {
   PoolWatch watch;
   for (int s = 0; s < 3 + PoolWatch::kProbeFirst; ++s) {
     ASSERT_TRUE(watch.startStep());
@@ -176,7 +179,13 @@ TEST(PoolWatch, LostCoresTakeOverFromAProbe) {
     ASSERT_FALSE(watch.startStep());
     watch.endSoloStep(1.0, 100);
   }
-  EXPECT_TRUE(watch.startStep());
+  for (int s = 0; s < 4; ++s) {
+    ASSERT_TRUE(watch.startStep());
+    EXPECT_FALSE(watch.endPoolStep(0, true, 1.2, 100)) << "pool step " << s;
+  }
+  ASSERT_TRUE(watch.startStep());
+  EXPECT_TRUE(watch.endPoolStep(0, true, 1.2, 100));
+  EXPECT_EQ(watch.aside(), AloneReason::Probe);
 }
 
 }  // namespace

@@ -54,8 +54,6 @@ struct alignas(64) Contact {
   bool enabled = true;                      // a callback may veto
   bool touching = false;                    // some point within the margin this step
   bool began = false;                       // first step touching (for events)
-  bool carried = false;                     // this step's copy of last step's manifold (asleep or recycled):
-                                            // its impulses are already its own, nothing to match
   Real depth_after = 0;                     // deepest overlap after the last step (the penetration watcher)
   Real rolling_friction = 0, torsional_friction = 0;
   Vec3 normal = Vec3::UnitY();              // from A to B, world

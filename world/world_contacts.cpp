@@ -77,7 +77,6 @@ bool recycleManifold(const WorldImpl& w, const Body& ba, const Body& bb, std::in
   out.push_back(o);  // made in place: one copy of the 700-byte manifold, not two
   Contact& c = out.back();
   c.enabled = true;  // the callback decides again
-  c.carried = true;
   c.normal = rotate(ba.orientation, o.made_normal);
   combineMaterials(w, ba, bb, c);
   const Transform ta = ba.transform(), tb = bb.transform();
@@ -232,6 +231,40 @@ std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>&
   }
 }
 
+// Warm start of a contact the narrowphase made: last step's contact of the
+// same key gives its impulses, point by point by feature id or, failing
+// that, within 2 cm on body A. `from` is the first of last step's contacts
+// not below the pair's first key, which no key of the pair is below: the
+// match is a few entries on, found without a second search over the list.
+void warmStartMade(const std::vector<Contact>& old, const std::vector<std::uint64_t>& old_keys, size_t from,
+                   Contact& c) {
+  const std::uint64_t key = c.key();
+  size_t i = from;
+  for (const size_t near = std::min(old_keys.size(), from + 8); i < near && old_keys[i] < key;) ++i;
+  if (i < old_keys.size() && old_keys[i] < key)  // a mesh pair's many triangles
+    i = static_cast<size_t>(std::lower_bound(old_keys.begin() + static_cast<std::ptrdiff_t>(i), old_keys.end(), key) -
+                            old_keys.begin());
+  if (i == old_keys.size() || old_keys[i] != key) {
+    c.began = true;
+    return;
+  }
+  const Contact& o = old[i];
+  c.began = !o.touching;
+  c.rolling_impulse = o.rolling_impulse;
+  for (int p = 0; p < c.count; ++p) {
+    ContactPointState& q = c.points[p];
+    const ContactPointState* match = nullptr;
+    for (int k = 0; k < o.count && !match; ++k)
+      if (o.points[k].feature_id == q.feature_id) match = &o.points[k];
+    for (int k = 0; k < o.count && !match; ++k)
+      if ((o.points[k].local_a - q.local_a).squaredNorm() < Real(4e-4)) match = &o.points[k];
+    if (match) {
+      q.normal_impulse = match->normal_impulse;
+      q.friction_impulse = match->friction_impulse;
+    }
+  }
+}
+
 bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys, int pa, int pb, Real h,
                  Real cos_half_angle, std::vector<Manifold>& manifolds, std::vector<Contact>& out) {
   const std::vector<Contact>& old = w.old_contacts_;
@@ -245,15 +278,20 @@ bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys,
   // Last step's contacts of this pair: their keys' high bits are the two
   // shapes.
   const auto cached = firstOldContact(old, old_keys, Contact::keyOf(sa, sb, -1));
-  if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were
+  if (pairAtRest(ba, bb)) {  // keep the cached contacts as they were, impulses and all
     for (auto it = cached; it != old.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
       out.push_back(*it);
-      out.back().carried = true;
+      out.back().began = !it->touching;
     }
     return false;
   }
-  if (recycleManifold(w, ba, bb, sa, sb, cached, old, cos_half_angle, out)) return true;
+  if (recycleManifold(w, ba, bb, sa, sb, cached, old, cos_half_angle, out)) {
+    out.back().began = false;  // recycled only from a touching manifold
+    return true;
+  }
+  const size_t first = out.size();
   narrowphasePair(w, ba, bb, ra, rb, sa, sb, h, manifolds, out);
+  for (size_t i = first; i < out.size(); ++i) warmStartMade(old, old_keys, static_cast<size_t>(cached - old.begin()), out[i]);
   return false;
 }
 
@@ -296,12 +334,11 @@ void collide(WorldImpl& w, StepContext& ctx) {
   if (at_rest) {
     old_contacts_.clear();
     old_keys.clear();
-    for (Contact& c : contacts_) {  // and warm started as below, in the same walk
-      c.carried = true;
-      c.began = !c.touching;
-    }
+    for (Contact& c : contacts_) c.began = !c.touching;  // impulses and all, as a pair at rest below
   } else {
-    // 2. Narrowphase over the candidate pairs, matching last step's contacts.
+    // 2. Narrowphase over the candidate pairs, matching last step's contacts
+    //    (warm start: each made contact takes the impulses of last step's
+    //    with the same key and feature ids).
     std::swap(old_contacts_, contacts_);
     contacts_.clear();
     const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
@@ -378,43 +415,8 @@ void collide(WorldImpl& w, StepContext& ctx) {
     if (!in_order) std::stable_sort(contacts_.begin(), contacts_.end(), by_key);
   }
 
-  // 3. Warm start: carry impulses from last step's points with the same
-  //    feature id (or, failing that, within 2 cm on body A).
-  const auto warmStart = [&](Contact& c) {
-    if (c.carried) {  // last step's own manifold: its impulses came with it
-      c.began = !c.touching;
-      return;
-    }
-    const auto it = firstOldContact(old_contacts_, old_keys, c.key());
-    if (it == old_contacts_.end() || it->key() != c.key()) {
-      c.began = true;
-      return;
-    }
-    c.began = !it->touching;
-    c.rolling_impulse = it->rolling_impulse;
-    for (int i = 0; i < c.count; ++i) {
-      ContactPointState& p = c.points[i];
-      const ContactPointState* match = nullptr;
-      for (int k = 0; k < it->count && !match; ++k)
-        if (it->points[k].feature_id == p.feature_id) match = &it->points[k];
-      for (int k = 0; k < it->count && !match; ++k)
-        if ((it->points[k].local_a - p.local_a).squaredNorm() < Real(4e-4)) match = &it->points[k];
-      if (match) {
-        p.normal_impulse = match->normal_impulse;
-        p.friction_impulse = match->friction_impulse;
-      }
-    }
-  };
-  // Each contact reads last step's list and writes only itself; a match is
-  // about as cheap as a recycled pair, so the pairs' threshold serves.
-  const int contact_count = static_cast<int>(contacts_.size());
-  const auto warmRange = [&](int begin, int end) {
-    for (int i = begin; i < end; ++i) warmStart(contacts_[static_cast<size_t>(i)]);
-  };
-  if (!at_rest) {  // at rest, done above
-    if (w.pool_ && contact_count >= kParallelPairs) w.pool_->parallelFor(contact_count, warmRange);
-    else warmRange(0, contact_count);
-  }
+  // 3. Warm start: done for each pair as its contacts were made
+  //    (collidePair); a world at rest keeps its contacts as they were.
 
   // 4. The user's callback may veto or modify each contact.
   if (w.contact_callback_) {

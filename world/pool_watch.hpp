@@ -41,6 +41,25 @@
 
 namespace cairn {
 
+// Which rules may set the pool aside: none, the lost cores' alone, or both.
+enum class PoolRules { None, LostCores, All };
+
+// A run length that starts at `first` and grows `factor` times with each
+// take, up to `most` (the runs alone and the gaps between probes below).
+class GrowingLength {
+ public:
+  constexpr GrowingLength(int first, int factor, int most) : first_(first), factor_(factor), most_(most), next_(first) {}
+  int take() {
+    const int n = next_;
+    next_ = std::min(factor_ * next_, most_);
+    return n;
+  }
+  void reset() { next_ = first_; }
+
+ private:
+  int first_, factor_, most_, next_;
+};
+
 class PoolWatch {
  public:
   static constexpr std::int64_t kPreemptedPerStep = 8;
@@ -67,15 +86,14 @@ class PoolWatch {
   // work (rows): whether the pool is set aside from the next step on.
   bool endPoolStep(std::int64_t preempted_waits, bool handed = false, double seconds = 0, int work = 0) {
     if (preempted_waits >= kPreemptedPerStep) {
-      solo_steps_ = solo_length_;
-      solo_length_ = std::min(2 * solo_length_, kSoloMost);
+      solo_steps_ = lost_cores_run_.take();
       aside_ = AloneReason::LostCores;
       pool_count_ = 0;
       judging_ = false;
       wake_ = true;
       return true;
     }
-    solo_length_ = kSoloFirst;
+    lost_cores_run_.reset();
     aside_ = AloneReason::None;
     if (!handed) return false;  // a step that hands nothing says nothing about the pool's gain
     if (wake_) {
@@ -87,9 +105,9 @@ class PoolWatch {
     if (judging_) {
       judging_ = false;
       if (soloBetter()) return setAsideForNoGain();
-      no_gain_length_ = kNoGainFirst;
-      probe_every_ = kProbeFirst;
-      to_probe_ = probe_every_;
+      no_gain_run_.reset();
+      probe_gap_.reset();
+      to_probe_ = kProbeFirst;
       return false;
     }
     if (--to_probe_ > 0) return false;
@@ -110,8 +128,7 @@ class PoolWatch {
       return;
     }
     if (aside_ == AloneReason::Probe) {
-      probe_every_ = std::min(4 * probe_every_, kProbeMost);
-      to_probe_ = probe_every_;
+      to_probe_ = probe_gap_.take();
     } else {
       judging_ = true;
     }
@@ -151,21 +168,20 @@ class PoolWatch {
   }
 
   bool setAsideForNoGain() {
-    solo_steps_ = no_gain_length_;
-    no_gain_length_ = std::min(2 * no_gain_length_, kNoGainMost);
+    solo_steps_ = no_gain_run_.take();
     solo_count_ = 0;
     aside_ = AloneReason::NoGain;
     return true;
   }
 
-  int solo_steps_ = 0;            // steps still to sit out
-  int solo_length_ = kSoloFirst;  // the next run alone, when the pool is found sharing again
+  int solo_steps_ = 0;  // steps still to sit out
+  GrowingLength lost_cores_run_{kSoloFirst, 2, kSoloMost};  // the runs alone when the pool is found sharing its cores
   AloneReason aside_ = AloneReason::None;
   std::array<Sample, kSample> pool_{}, solo_{};  // the latest steps on the pool and alone, as rings
   int pool_count_ = 0, solo_count_ = 0;          // samples taken since the rings were last emptied
-  int probe_every_ = kProbeFirst;                // pool steps from one probe to the next
   int to_probe_ = kProbeFirst;                   // pool steps until the next probe
-  int no_gain_length_ = kNoGainFirst;            // the next run alone, when the pool is found not paying
+  GrowingLength probe_gap_{4 * kProbeFirst, 4, kProbeMost};  // pool steps between the probes after the first
+  GrowingLength no_gain_run_{kNoGainFirst, 2, kNoGainMost};  // the runs alone when the pool is found not paying
   bool judging_ = false;                         // back from a run alone for no gain: judge the pool again
   bool wake_ = false;                            // the next pool step is its workers' wake-up
 };

@@ -412,12 +412,11 @@ class WorldImpl {
   // small to split (a lone body, a chain, an asleep pile) does not wake
   // a worker each step for nothing.
   bool warm_pool_ = false;
-  // false: the pool is never set aside (the tests that must run every step
-  // on their threads, whatever else the machine runs).
-  bool watch_pool_ = true;
-  // false: steps are not timed against steps alone, so only lost cores
-  // set the pool aside (the test of that rule under the real scheduler).
-  bool time_pool_ = true;
+  // Which of the pool watch's rules apply (world/pool_watch.hpp): all by
+  // default; the tests that must run every step on their threads whatever
+  // else the machine runs apply none, and the test of the lost cores'
+  // rule under the real scheduler that rule alone.
+  PoolRules pool_rules_ = PoolRules::All;
   std::uint64_t rng_state_ = 0;
   bool rng_seeded_ = false;
 

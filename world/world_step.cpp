@@ -104,8 +104,9 @@ void watchPool(WorldImpl& w, double seconds) {
     return;
   }
   const std::int64_t preempted = w.pool_->takePreemptedWaits();
-  const bool handed = w.time_pool_ && w.pool_->loops() > 0;  // a step not handed a loop is not timed
-  if (w.watch_pool_ && w.pool_watch_.endPoolStep(preempted, handed, seconds, w.stats_.rows))
+  // A step not handed a loop is not timed; with the lost cores' rule alone, none is.
+  const bool handed = w.pool_rules_ == PoolRules::All && w.pool_->loops() > 0;
+  if (w.pool_rules_ != PoolRules::None && w.pool_watch_.endPoolStep(preempted, handed, seconds, w.stats_.rows))
     w.parked_pool_ = std::move(w.pool_);
 }
 

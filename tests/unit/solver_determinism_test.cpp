@@ -39,7 +39,7 @@ struct Pose {
 World threadedWorld(SceneDesc s, int threads) {
   s.solver.threads = threads;
   World w = buildWorld(s);
-  detail::internals(w).watch_pool_ = false;
+  detail::internals(w).pool_rules_ = PoolRules::None;
   return w;
 }
 
@@ -90,7 +90,7 @@ TEST(Determinism, AWorldWhoseThreadsShareOneCoreStepsAloneWithTheSameBits) {
     // scheduler leaves clear would otherwise be timed against steps alone
     // on the shared core, and the pool set aside for no gain (that rule's
     // own tests: PoolWatch.*).
-    detail::internals(w).time_pool_ = false;
+    detail::internals(w).pool_rules_ = PoolRules::LostCores;
     for (int k = 0; k < kSharedSteps; ++k) {
       w.step(s.dt);
       threads.push_back(w.lastStepStats().threads);

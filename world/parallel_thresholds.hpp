@@ -13,8 +13,8 @@
 
 namespace cairn::detail {
 
-// Pairs below which collide (world/world_contacts.cpp: the narrowphase,
-// then the warm-start matching of new contacts) stays on the calling
+// Pairs below which collide (world/world_contacts.cpp: the narrowphase
+// and the warm start of the contacts it makes) stays on the calling
 // thread. A fresh narrowphase call is 0.2 to 2 us, but a resting pair is
 // recycled or kept for a tenth of that, and the second thread's contacts
 // are then copied into the list (704 bytes each): with 64, an awake

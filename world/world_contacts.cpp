@@ -179,11 +179,6 @@ std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>&
   return old.begin() + (std::lower_bound(old_keys.begin(), old_keys.end(), key) - old_keys.begin());
 }
 
-// One candidate pair (broadphase handles pa, pb): its contacts appended to
-// `out`, last step's kept as they were when neither body moves, else a
-// recycled manifold, else the narrowphase's. Reads the world only (the
-// pool's threads run it side by side); `manifolds` is scratch. Returns
-// whether a manifold was recycled.
 // A pair through the narrowphase: its manifolds as new contacts, each
 // point's anchors fixed on the two bodies. Kept out of collidePair, whose
 // common paths (a pair at rest, a recycled manifold) stay small: with this
@@ -235,7 +230,8 @@ std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>&
 // that, within 2 cm on body A. `from` is the first of last step's contacts
 // not below the pair's first key, which no key of the pair is below: the
 // match is a few entries on, found without a second search over the list.
-void warmStartMade(const std::vector<Contact>& old, const std::vector<std::uint64_t>& old_keys, size_t from,
+// Returns whether there was one.
+bool warmStartMade(const std::vector<Contact>& old, const std::vector<std::uint64_t>& old_keys, size_t from,
                    Contact& c) {
   const std::uint64_t key = c.key();
   size_t i = from;
@@ -245,7 +241,7 @@ void warmStartMade(const std::vector<Contact>& old, const std::vector<std::uint6
                             old_keys.begin());
   if (i == old_keys.size() || old_keys[i] != key) {
     c.began = true;
-    return;
+    return false;
   }
   const Contact& o = old[i];
   c.began = !o.touching;
@@ -262,10 +258,17 @@ void warmStartMade(const std::vector<Contact>& old, const std::vector<std::uint6
       q.friction_impulse = match->friction_impulse;
     }
   }
+  return true;
 }
 
-bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys, int pa, int pb, Real h,
-                 Real cos_half_angle, std::vector<Manifold>& manifolds, std::vector<Contact>& out) {
+// One candidate pair (broadphase handles pa, pb): its contacts appended to
+// `out`, last step's kept as they were when neither body moves, else a
+// recycled manifold, else the narrowphase's, warm started from last
+// step's. Reads the world only (the pool's threads run it side by side);
+// `manifolds` is scratch; `counts` grows by what the contacts were.
+void collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys, int pa, int pb, Real h,
+                 Real cos_half_angle, std::vector<Manifold>& manifolds, std::vector<Contact>& out,
+                 StepContext::PairCounts& counts) {
   const std::vector<Contact>& old = w.old_contacts_;
   std::int32_t sa = w.broadphase_.user(pa), sb = w.broadphase_.user(pb);
   if (sa > sb) std::swap(sa, sb);
@@ -273,7 +276,7 @@ bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys,
   const ShapeRef& rb = w.shapes_[static_cast<size_t>(sb)];
   const Body& ba = w.body(ra.body);
   const Body& bb = w.body(rb.body);
-  if (!w.shouldCollide(ba, bb, ra.body, rb.body)) return false;
+  if (!w.shouldCollide(ba, bb, ra.body, rb.body)) return;
   // Last step's contacts of this pair: their keys' high bits are the two
   // shapes.
   const auto cached = firstOldContact(old, old_keys, Contact::keyOf(sa, sb, -1));
@@ -281,17 +284,23 @@ bool collidePair(const WorldImpl& w, const std::vector<std::uint64_t>& old_keys,
     for (auto it = cached; it != old.end() && it->shape_a == sa && it->shape_b == sb; ++it) {
       out.push_back(*it);
       out.back().began = !it->touching;
+      counts.began += out.back().began;
+      ++counts.continued;
     }
-    return false;
+    return;
   }
   if (recycleManifold(w, ba, bb, sa, sb, cached, old, cos_half_angle, out)) {
     out.back().began = false;  // recycled only from a touching manifold
-    return true;
+    ++counts.recycled;
+    ++counts.continued;
+    return;
   }
   const size_t first = out.size();
   narrowphasePair(w, ba, bb, ra, rb, sa, sb, h, manifolds, out);
-  for (size_t i = first; i < out.size(); ++i) warmStartMade(old, old_keys, static_cast<size_t>(cached - old.begin()), out[i]);
-  return false;
+  for (size_t i = first; i < out.size(); ++i) {
+    counts.continued += warmStartMade(old, old_keys, static_cast<size_t>(cached - old.begin()), out[i]);
+    counts.began += out[i].began;
+  }
 }
 
 }  // namespace
@@ -330,10 +339,18 @@ void collide(WorldImpl& w, StepContext& ctx) {
   // contacts stay where they are, and last step's list is emptied so that
   // the events see nothing end.
   const bool at_rest = !pairs_changed && pairsAtRest(w);
+  ctx.some_began = true;  // unknown until found below
+  ctx.all_continued = false;
   if (at_rest) {
     old_contacts_.clear();
     old_keys.clear();
-    for (Contact& c : contacts_) c.began = !c.touching;  // impulses and all, as a pair at rest below
+    bool began = false;
+    for (Contact& c : contacts_) {  // impulses and all, as a pair at rest below
+      c.began = !c.touching;
+      began = began || c.began;
+    }
+    ctx.some_began = began;
+    ctx.all_continued = true;  // last step's list is empty
   } else {
     // 2. Narrowphase over the candidate pairs, matching last step's contacts
     //    (warm start: each made contact takes the impulses of last step's
@@ -353,17 +370,19 @@ void collide(WorldImpl& w, StepContext& ctx) {
       readKeys();
     }
     const Real cos_half_angle = std::cos(settings_.recycle_angle / 2);
-    // A range of pairs: appends their contacts to `out`, counts the
-    // recycled manifolds, and says whether the contacts came in key order
-    // (each key read as it is written, not in a walk over the list after).
+    // A range of pairs: appends their contacts to `out`, counts what they
+    // were, and says whether they came in strictly increasing key order
+    // (each key read as it is written, not in a walk over the list after;
+    // strictly, so that in order the keys are also unique and the counts
+    // say which of last step's contacts continue).
     const auto pairRange = [&](int begin, int end, std::vector<Contact>& out, std::vector<Manifold>& manifolds,
-                               int& recycled) {
+                               StepContext::PairCounts& counts) {
       bool sorted = true;
       for (int k = begin; k < end; ++k) {
         const auto& [pa, pb] = w.pairs_[static_cast<size_t>(k)];
         const size_t first = out.size();
-        recycled += collidePair(w, old_keys, pa, pb, h, cos_half_angle, manifolds, out);
-        for (size_t i = std::max<size_t>(first, 1); i < out.size(); ++i) sorted = sorted && !(out[i].key() < out[i - 1].key());
+        collidePair(w, old_keys, pa, pb, h, cos_half_angle, manifolds, out, counts);
+        for (size_t i = std::max<size_t>(first, 1); i < out.size(); ++i) sorted = sorted && out[i - 1].key() < out[i].key();
       }
       return sorted;
     };
@@ -375,11 +394,12 @@ void collide(WorldImpl& w, StepContext& ctx) {
     // the same order whatever the split). The user's filter callback is
     // called from the stepping thread only.
     bool in_order = true;
+    StepContext::PairCounts total;
     if (w.pool_ && pair_count >= kParallelPairs && !w.filter_callback_) {
       const auto threads = static_cast<size_t>(w.pool_->threads());
       ctx.pair_contacts.resize(threads);
       ctx.pair_manifolds.resize(threads);
-      ctx.pair_recycled.assign(threads, 0);
+      ctx.pair_counts.assign(threads, {});
       ctx.pair_sorted.assign(threads, 1);
       for (size_t t = 1; t < threads; ++t) ctx.pair_contacts[t].clear();  // a thread may have no pairs
       ctx.pair_split.plan(pair_count, static_cast<int>(threads));
@@ -389,24 +409,27 @@ void collide(WorldImpl& w, StepContext& ctx) {
           const auto start = std::chrono::steady_clock::now();
           std::vector<Contact>& out = t == 0 ? contacts_ : ctx.pair_contacts[t];
           ctx.pair_sorted[t] =
-              pairRange(ctx.pair_split.begin(r), ctx.pair_split.end(r), out, ctx.pair_manifolds[t], ctx.pair_recycled[t]);
+              pairRange(ctx.pair_split.begin(r), ctx.pair_split.end(r), out, ctx.pair_manifolds[t], ctx.pair_counts[t]);
           ctx.pair_split.record(r, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         }
       });
       for (size_t t = 0; t < threads; ++t) {
         if (t > 0) {
           const std::vector<Contact>& part = ctx.pair_contacts[t];
-          if (!part.empty() && !contacts_.empty() && part.front().key() < contacts_.back().key()) in_order = false;
+          if (!part.empty() && !contacts_.empty() && !(contacts_.back().key() < part.front().key())) in_order = false;
           contacts_.insert(contacts_.end(), part.begin(), part.end());
         }
         in_order = in_order && ctx.pair_sorted[t];
-        w.stats_.recycled_contacts += ctx.pair_recycled[t];
+        total.recycled += ctx.pair_counts[t].recycled;
+        total.began += ctx.pair_counts[t].began;
+        total.continued += ctx.pair_counts[t].continued;
       }
     } else {
-      int recycled = 0;
-      in_order = pairRange(0, pair_count, contacts_, ctx.pair_manifolds[0], recycled);
-      w.stats_.recycled_contacts += recycled;
+      in_order = pairRange(0, pair_count, contacts_, ctx.pair_manifolds[0], total);
     }
+    w.stats_.recycled_contacts += total.recycled;
+    ctx.some_began = total.began > 0;
+    ctx.all_continued = in_order && static_cast<size_t>(total.continued) == old_contacts_.size();
     // Contacts in key order (deterministic, and for the lookup below). The
     // broadphase hands pairs over in a stable order, so this is usually
     // sorted already: checked as they were written, which spares moving
@@ -490,9 +513,15 @@ void emitContactEvents(WorldImpl& w, StepContext& ctx) {
       out.push_back(event(o, ContactEvent::Type::End));
     }
   };
-  // On the pool's threads when the lists are long, each thread's events
-  // kept apart and joined in range order: the order of one thread's walks.
-  const int n = static_cast<int>(contacts_.size()), n_old = static_cast<int>(old.size());
+  // Each walk only where collide did not find it empty: no contact began,
+  // or every one of last step's continues (most steps of a scene in
+  // motion). On the pool's threads when the lists are long, each thread's
+  // events kept apart and joined in range order: the order of one
+  // thread's walks.
+  const int n = ctx.some_began ? static_cast<int>(contacts_.size()) : 0;
+  const int n_old = ctx.all_continued ? 0 : static_cast<int>(old.size());
+  ctx.some_began = true;  // unknown until the next collide
+  ctx.all_continued = false;
   std::vector<ContactEvent>& events = w.contact_events_;
   if (w.pool_ && n + n_old >= kParallelContacts) {
     const auto threads = static_cast<size_t>(w.pool_->threads());

@@ -131,7 +131,19 @@ struct StepContext {
   std::vector<std::int32_t> lane_pushing;  // per batch lane: the island its contact pushes out, else -1
   std::vector<std::vector<Contact>> pair_contacts;  // collide's threads: per thread, the contacts of its pairs
   std::vector<std::vector<Manifold>> pair_manifolds;  // per thread, narrowphase scratch ([0]: the calling thread)
-  std::vector<int> pair_recycled;
+  // Per thread, what its pairs' contacts were: recycled manifolds, contacts
+  // that began (no touching contact of their key last step) and contacts
+  // that continue one of last step's (the same key).
+  struct PairCounts {
+    int recycled = 0, began = 0, continued = 0;
+  };
+  std::vector<PairCounts> pair_counts;
+  // What collide found for the events (world/world_contacts.cpp): whether
+  // some contact began, and whether each of last step's contacts has one
+  // of its key this step (then none ended). Where unknown, both true and
+  // false, and the events walk the lists.
+  bool some_began = true;
+  bool all_continued = false;
   std::vector<std::uint8_t> pair_sorted;  // per thread: whether its contacts came in key order
   CostSplit pair_split;                   // collide's threads: their ranges of pairs, by last step's time
   // Scratch of the colouring.
@@ -233,9 +245,9 @@ struct StepContext {
   std::vector<char> sunk_below;
   // Body pairs a joint keeps from colliding, sorted (collide, shouldCollide).
   std::vector<std::uint64_t> jointed_pairs;
-  // Last step's contacts' keys, in their (sorted) order: the pairs' and the
-  // warm start's binary searches run over these 8 bytes a contact instead
-  // of touching a 704-byte contact at every probe.
+  // Last step's contacts' keys, in their (sorted) order: the pairs' binary
+  // searches run over these 8 bytes a contact instead of touching a
+  // 704-byte contact at every probe.
   std::vector<std::uint64_t> old_keys;
 };
 

@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <set>
+#include <tuple>
 
 namespace cairn {
 namespace {
@@ -282,6 +286,59 @@ TEST(Events, BeginWithImpulseAndEnd) {
   EXPECT_EQ(ends, 0);
   // Falling 1 m: v = sqrt(2 g) = 4.43 m/s stopped by the landing impulse (>= m v minus a step's gravity).
   EXPECT_GT(impulse, std::sqrt(2 * 9.81) - 9.81 * kH - 0.1);
+}
+
+// Each step's events are exactly the difference of the contact lists:
+// Begin for every enabled contact whose key had no touching contact the
+// step before, End for every touching, enabled contact of the step before
+// whose key is gone (collide tells the events when a list has nothing to
+// walk for; this holds it to the definition). Balls bounce on the stack
+// and the ground, leaving and touching again (begins and ends in the same
+// steps as continuing contacts), the stack sleeps and a ball is taken
+// away; on one thread and on two (the pyramid's 590 pairs are past the
+// pool's threshold).
+TEST(Events, EachStepsEventsAreTheContactsThatBeganAndEnded) {
+  using Key = std::tuple<std::int32_t, std::int32_t>;  // one shape a body here: the body pair names the contact
+  const auto keys = [](const World& w, bool touching_only) {
+    std::multiset<Key> k;
+    for (const Contact& c : cairn::detail::internals(w).contacts_)
+      if (c.enabled && (!touching_only || c.touching)) k.insert({c.body_a.index, c.body_b.index});
+    return k;
+  };
+  for (const int threads : {1, 2}) {
+    SceneDesc scene = scenarios::byName("pyramid-20");
+    scene.solver.threads = threads;
+    scene.solver.sleeping = true;
+    for (int i = 0; i < 12; ++i) {
+      BodyDef ball = test::sphereDef("ball" + std::to_string(i), Vec3(-14 + 2.5 * i, 3 + (i % 4), 1.5 * (i % 3) - 1.5), 1, 0.3);
+      ball.restitution = 0.7;
+      scene.bodies.push_back(ball);
+    }
+    World w = buildWorld(scene);
+    cairn::detail::internals(w).pool_rules_ = PoolRules::None;  // every step on its threads
+    int begins = 0, ends = 0;
+    for (int s = 0; s < 300; ++s) {
+      if (s == 200) w.destroyBody(w.findBody("ball5"));
+      std::multiset<Key> before = keys(w, true);
+      std::multiset<Key> removed;  // contacts of the destroyed ball end too
+      for (const Contact& c : cairn::detail::internals(w).ended_contacts_)
+        if (c.touching && c.enabled) removed.insert({c.body_a.index, c.body_b.index});
+      w.step(scene.dt);
+      const std::multiset<Key> after = keys(w, false);
+      std::multiset<Key> began, ended, got_began, got_ended;
+      std::set_difference(after.begin(), after.end(), before.begin(), before.end(), std::inserter(began, began.end()));
+      std::set_difference(before.begin(), before.end(), after.begin(), after.end(), std::inserter(ended, ended.end()));
+      ended.insert(removed.begin(), removed.end());
+      for (const ContactEvent& e : w.contactEvents())
+        (e.type == ContactEvent::Type::Begin ? got_began : got_ended).insert({e.body_a.index, e.body_b.index});
+      ASSERT_EQ(got_began, began) << threads << " threads, step " << s;
+      ASSERT_EQ(got_ended, ended) << threads << " threads, step " << s;
+      begins += static_cast<int>(began.size());
+      ends += static_cast<int>(ended.size());
+    }
+    EXPECT_GT(ends, 12) << "the balls bounce: contacts end while others continue";
+    EXPECT_GE(begins, 590 + 12) << "each of the pyramid's contacts and each ball's first landing";
+  }
 }
 
 // Only what the scene needs: no friction rows when mu = 0; a jointed pair

@@ -100,6 +100,10 @@ struct alignas(64) Body {
   std::optional<Mat3> def_inertia;
 
   bool isDynamic() const { return type == BodyType::Dynamic; }
+  // What the solver's rows see: a static or kinematic body has no inverse
+  // mass or inertia (its velocity is given, not solved).
+  Real solverInvMass() const { return isDynamic() ? inv_mass : Real(0); }
+  Mat3 solverInvInertia() const { return isDynamic() ? inv_inertia_world : Mat3(Mat3::Zero()); }
   // A kinematic body with a velocity: it moves in every step, asleep
   // bodies it touches included.
   bool isMovingKinematic() const {

@@ -124,8 +124,8 @@ void gatherPoses(ContactBatchInput& in, int lane, const Contact& c, const WorldI
 }
 
 // A body's mass data and velocities into one side of a lane, as
-// WorldImpl::view has them (a static or kinematic body with no inverse
-// mass or inertia; the world unlocked, at rest, without either) but read
+// WorldImpl::view has them (Body::solverInvMass and solverInvInertia; the
+// world unlocked, at rest, without either) but read
 // straight from the body: a view is 300 bytes made twice a manifold, and
 // the 5,050-box pyramid made 28,000 of them a step.
 void gatherSide(ContactBatchInput::Side& s, int lane, BodyId id, const WorldImpl& w) {
@@ -140,14 +140,14 @@ void gatherSide(ContactBatchInput::Side& s, int lane, BodyId id, const WorldImpl
     return;
   }
   const Body& b = w.bodies_[static_cast<size_t>(id.index)];
-  const bool dynamic = b.isDynamic();
+  const Mat3 inv_inertia = b.solverInvInertia();
   for (int k = 0; k < 3; ++k) {
     s.lin_factor[k][lane] = b.linear_factor[k];
     s.v[k][lane] = b.linear_velocity[k];
     s.w[k][lane] = b.angular_velocity[k];
-    for (int j = 0; j < 3; ++j) s.inv_inertia[3 * k + j][lane] = dynamic ? b.inv_inertia_world(k, j) : Real(0);
+    for (int j = 0; j < 3; ++j) s.inv_inertia[3 * k + j][lane] = inv_inertia(k, j);
   }
-  s.inv_mass[lane] = dynamic ? b.inv_mass : Real(0);
+  s.inv_mass[lane] = b.solverInvMass();
 }
 
 // One manifold and its bodies (solver indices ia, ib) into one lane of the

@@ -9,7 +9,6 @@ namespace cairn::detail {
 
 BodyView WorldImpl::view(int index) const {
   const Body& b = bodies_[static_cast<size_t>(index)];
-  const bool dynamic = b.isDynamic();
   // Every member written once (a default-constructed view would first be
   // filled with identities and zeros; the step makes a view per joint side
   // several times a step).
@@ -17,9 +16,9 @@ BodyView WorldImpl::view(int index) const {
                   .x = b.position,
                   .q = b.orientation,
                   .rot = b.rotation,
-                  .inv_mass = dynamic ? b.inv_mass : Real(0),
+                  .inv_mass = b.solverInvMass(),
                   .lin_factor = b.linear_factor,
-                  .inv_inertia = dynamic ? b.inv_inertia_world : Mat3(Mat3::Zero()),
+                  .inv_inertia = b.solverInvInertia(),
                   .v = b.linear_velocity,
                   .w = b.angular_velocity};
 }

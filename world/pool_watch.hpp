@@ -19,14 +19,21 @@
 // machine an awake pyramid-20 stepped 1.2 to 1.65 times slower on two
 // threads than on one, docs/performance.md, "Threads"). So the watch measures the
 // pool's gain on the scene as it runs: after kProbeFirst steps that
-// handed the pool a loop, it steps kSample steps alone (a probe) and
-// compares their wall time with that of the kSample pool steps before.
+// handed the pool a loop, it steps alone for a while (a probe) and
+// compares the wall time of kSample steps alone with that of the kSample
+// pool steps before. A run alone's first step is not one of them: it
+// reads the bodies, rows and contacts the pool's threads wrote last, from
+// the other cores' caches, and ran 1.3 times as long as the steps alone
+// after it on an awake pyramid-20 (1.38 against 1.05 ms); counted, it
+// made a pool that lost 8% look as fast as the calling thread alone
+// (pile-1000's awake steps, docs/performance.md, "Threads"). So a probe is
+// kSample + 1 steps.
 // Where the steps alone took less than kSoloBetter of the pool's time, the
 // pool sits out kNoGainFirst steps, twice as many each time it is found
 // not paying again (up to kNoGainMost), and is judged again on its
 // kSample steps after each return. Where it pays, the next probe comes
 // four times as many steps later (up to kProbeMost): a probe's steps alone
-// are what the rule costs a scene whose pool pays (two probes, 8 of the
+// are what the rule costs a scene whose pool pays (two probes, 10 of the
 // 5,050-box pyramid's first 100 steps). Steps are compared only
 // when they did about the same work (rows within kSameWork of each other),
 // the pool's only when it was handed a loop, and never the first step on
@@ -111,8 +118,9 @@ class PoolWatch {
       return false;
     }
     if (--to_probe_ > 0) return false;
-    solo_steps_ = kSample;
+    solo_steps_ = kSample + 1;
     solo_count_ = 0;
+    first_alone_ = true;
     aside_ = AloneReason::Probe;
     return true;
   }
@@ -121,7 +129,8 @@ class PoolWatch {
   // the next startStep unless this ends a probe that found no gain.
   void endSoloStep(double seconds, int work) {
     if (aside_ == AloneReason::LostCores || aside_ == AloneReason::None) return;  // shared cores' times say nothing
-    solo_[static_cast<size_t>(solo_count_++ % kSample)] = {seconds, work};
+    if (first_alone_) first_alone_ = false;  // the pool's data still in the other cores' caches: not a sample
+    else solo_[static_cast<size_t>(solo_count_++ % kSample)] = {seconds, work};
     if (solo_steps_ > 0) return;
     if (aside_ == AloneReason::Probe && solo_count_ >= kSample && soloBetter()) {
       setAsideForNoGain();
@@ -170,6 +179,7 @@ class PoolWatch {
   bool setAsideForNoGain() {
     solo_steps_ = no_gain_run_.take();
     solo_count_ = 0;
+    first_alone_ = aside_ != AloneReason::Probe;  // straight after a probe the data is this thread's already
     aside_ = AloneReason::NoGain;
     return true;
   }
@@ -183,6 +193,7 @@ class PoolWatch {
   GrowingLength probe_gap_{4 * kProbeFirst, 4, kProbeMost};  // pool steps between the probes after the first
   GrowingLength no_gain_run_{kNoGainFirst, 2, kNoGainMost};  // the runs alone when the pool is found not paying
   bool judging_ = false;                         // back from a run alone for no gain: judge the pool again
+  bool first_alone_ = false;                     // the next step alone is a run's first after pool steps
   bool wake_ = false;                            // the next pool step is its workers' wake-up
 };
 

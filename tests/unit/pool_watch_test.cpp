@@ -95,15 +95,16 @@ std::vector<RunAlone> timedRuns(PoolWatch& watch, int steps, double pool, double
 
 // Steps alone 20% faster than on the pool: the first probe comes after
 // kProbeFirst + 3 pool steps (the fourth, which fills the ring, is the
-// interval's first); it finds no gain, so the pool
+// interval's first), 5 steps alone (its first not a sample); it finds no
+// gain, so the pool
 // sits out 16 steps, comes back (a wake-up step, 4 steps judged), is found
 // not paying again and sits out twice as long, up to 256.
 TEST(PoolWatch, AloneFasterSetsThePoolAsideForLongerEachTime) {
   constexpr int kProbe = 3 + PoolWatch::kProbeFirst;  // pool steps 0, 1, 2 fill the ring with the first decrement's
   PoolWatch watch;
   const std::vector<RunAlone> runs = timedRuns(watch, 700, 1.2, 1.0);
-  std::vector<RunAlone> expected{{kProbe, 4, AloneReason::Probe}, {kProbe + 4, 16, AloneReason::NoGain}};
-  int at = kProbe + 20;
+  std::vector<RunAlone> expected{{kProbe, 5, AloneReason::Probe}, {kProbe + 5, 16, AloneReason::NoGain}};
+  int at = kProbe + 21;
   for (const int length : {32, 64, 128, 256, 256}) {
     at += 5;  // the wake-up step and 4 judged
     if (at >= 700) break;
@@ -113,29 +114,49 @@ TEST(PoolWatch, AloneFasterSetsThePoolAsideForLongerEachTime) {
   EXPECT_EQ(runs, expected);
 }
 
-// The pool 20% faster: each probe of 4 steps finds it paying, and the next
+// The pool 20% faster: each probe of 5 steps finds it paying, and the next
 // comes four times as many pool steps later (a wake-up step, 4 to fill the
 // ring again, then the interval), up to kProbeMost.
 TEST(PoolWatch, ThePoolPayingIsProbedFourTimesAsRarelyEachTime) {
   constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
   PoolWatch watch;
   const std::vector<RunAlone> runs = timedRuns(watch, 3000, 0.8, 1.0);
-  std::vector<RunAlone> expected{{kProbe, 4, AloneReason::Probe}};
-  int at = kProbe + 4;
+  std::vector<RunAlone> expected{{kProbe, 5, AloneReason::Probe}};
+  int at = kProbe + 5;
   for (int every = 4 * PoolWatch::kProbeFirst;; every = std::min(4 * every, PoolWatch::kProbeMost)) {
     at += 1 + 3 + every;
     if (at >= 3000) break;
-    expected.push_back({at, 4, AloneReason::Probe});
-    at += 4;
+    expected.push_back({at, 5, AloneReason::Probe});
+    at += 5;
   }
   EXPECT_EQ(runs, expected);
-  EXPECT_EQ(runs.back().first - runs[runs.size() - 2].first, 4 + 1 + 3 + PoolWatch::kProbeMost);
+  EXPECT_EQ(runs.back().first - runs[runs.size() - 2].first, 5 + 1 + 3 + PoolWatch::kProbeMost);
 }
 
 // Alone within 3% of the pool (kSoloBetter): the pool stays.
 TEST(PoolWatch, AloneBarelyFasterKeepsThePool) {
   PoolWatch watch;
   for (const RunAlone& r : timedRuns(watch, 600, 1.0, 0.98)) EXPECT_EQ(r.why, AloneReason::Probe);
+}
+
+// A probe's first step alone reads what the pool's threads wrote last and
+// runs slow (here twice as long as the steps alone after it): it is not a
+// sample. The pool at 1.2, alone 1.0 after a first step of 2.0: counted,
+// the first step would make alone 1.25 a step, slower than the pool;
+// dropped, alone is 1.0 and the pool sits out.
+TEST(PoolWatch, AProbesFirstStepAloneIsNotASample) {
+  PoolWatch watch;
+  for (int s = 0; s < 3 + PoolWatch::kProbeFirst; ++s) {
+    ASSERT_TRUE(watch.startStep());
+    watch.endPoolStep(0, true, 1.2, 100);
+  }
+  for (int s = 0; s < PoolWatch::kSample + 1; ++s) {
+    ASSERT_FALSE(watch.startStep()) << "probe step " << s;
+    EXPECT_EQ(watch.aside(), AloneReason::Probe);
+    watch.endSoloStep(s == 0 ? 2.0 : 1.0, 100);
+  }
+  EXPECT_EQ(watch.aside(), AloneReason::NoGain);
+  EXPECT_FALSE(watch.startStep());
 }
 
 // Steps that hand the pool nothing never lead to a probe; nor does a probe
@@ -147,9 +168,9 @@ TEST(PoolWatch, StepsHandingNothingOrOfOtherWorkGiveNoVerdict) {
   PoolWatch watch;
   EXPECT_TRUE(timedRuns(watch, 500, 1.2, 1.0, 100, false).empty());
   watch.reset();
-  const int next_probe = kProbe + 4 + 1 + 3 + 4 * PoolWatch::kProbeFirst;
+  const int next_probe = kProbe + 5 + 1 + 3 + 4 * PoolWatch::kProbeFirst;
   EXPECT_EQ(timedRuns(watch, next_probe, 1.2, 1.0, 100, true, kProbe),
-            (std::vector<RunAlone>{{kProbe, 4, AloneReason::Probe}}));
+            (std::vector<RunAlone>{{kProbe, 5, AloneReason::Probe}}));
 }
 
 // Lost cores when the pool returns from a run alone for no gain: the lost
@@ -162,7 +183,7 @@ TEST(PoolWatch, LostCoresTakeOverFromTheGainRule) {
     ASSERT_TRUE(watch.startStep());
     watch.endPoolStep(0, true, 1.2, 100);
   }
-  for (int s = 0; s < 4; ++s) {  // the probe, alone faster: no gain
+  for (int s = 0; s < 5; ++s) {  // the probe, alone faster: no gain
     ASSERT_FALSE(watch.startStep());
     EXPECT_EQ(watch.aside(), AloneReason::Probe);
     watch.endSoloStep(1.0, 100);

@@ -5,6 +5,7 @@
 #include "collision/aabb.hpp"
 #include "collision/narrowphase.hpp"
 #include "world/parallel_thresholds.hpp"
+#include "world/sorted_keys.hpp"
 #include "world/step_stages.hpp"
 
 #include <algorithm>
@@ -173,30 +174,11 @@ bool pairsAtRest(const WorldImpl& w) {
 
 // The first of last step's contacts whose key is not below `key` (they
 // are sorted by key), searched in their keys alone, not the 704-byte
-// contacts, from `cursor`: the last pair's answer, moved to this one's.
-// The broadphase hands a thread's pairs over in the order of their keys,
-// mostly, so the answer is usually a few keys on: a gallop from the
-// cursor (one, two, four ... keys on, then a binary search in the last
-// stride) finds it in a few probes near the keys just read, where a
-// binary search over the whole list took fourteen on the 5,050-box
-// pyramid's 15,000, most of them cache misses. The answer is
-// std::lower_bound's over the whole list whatever the cursor.
+// contacts, from `cursor`: the last pair's answer (world/sorted_keys.hpp).
 std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>& old,
                                                      const std::vector<std::uint64_t>& old_keys, std::uint64_t key,
                                                      size_t& cursor) {
-  const auto at = [&](size_t i) { return old_keys.begin() + static_cast<std::ptrdiff_t>(i); };
-  const size_t n = old_keys.size();
-  size_t lo = std::min(cursor, n), hi = lo;
-  if (lo > 0 && old_keys[lo - 1] >= key) {  // behind the cursor: the pairs left key order
-    lo = 0;
-  } else {  // every key before lo is below `key`
-    for (size_t stride = 1; hi < n && old_keys[hi] < key; stride *= 2) {
-      lo = hi + 1;
-      hi = std::min(n, lo + stride);
-    }
-  }
-  cursor = static_cast<size_t>(std::lower_bound(at(lo), at(hi), key) - old_keys.begin());
-  return old.begin() + static_cast<std::ptrdiff_t>(cursor);
+  return old.begin() + static_cast<std::ptrdiff_t>(lowerBoundFrom(old_keys, key, cursor));
 }
 
 // A pair through the narrowphase: its manifolds as new contacts, each

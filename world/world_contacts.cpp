@@ -231,16 +231,13 @@ std::vector<Contact>::const_iterator firstOldContact(const std::vector<Contact>&
 // same key gives its impulses, point by point by feature id or, failing
 // that, within 2 cm on body A. `from` is the first of last step's contacts
 // not below the pair's first key, which no key of the pair is below: the
-// match is a few entries on, found without a second search over the list.
-// Returns whether there was one.
+// match is a few entries on (many, for a mesh pair's triangles), found by
+// the gallop from there (world/sorted_keys.hpp), not a search over the
+// whole list. Returns whether there was one.
 bool warmStartMade(const std::vector<Contact>& old, const std::vector<std::uint64_t>& old_keys, size_t from,
                    Contact& c) {
   const std::uint64_t key = c.key();
-  size_t i = from;
-  for (const size_t near = std::min(old_keys.size(), from + 8); i < near && old_keys[i] < key;) ++i;
-  if (i < old_keys.size() && old_keys[i] < key)  // a mesh pair's many triangles
-    i = static_cast<size_t>(std::lower_bound(old_keys.begin() + static_cast<std::ptrdiff_t>(i), old_keys.end(), key) -
-                            old_keys.begin());
+  const size_t i = lowerBoundFrom(old_keys, key, from);
   if (i == old_keys.size() || old_keys[i] != key) {
     c.began = true;
     return false;

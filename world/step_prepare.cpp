@@ -28,6 +28,7 @@
 // colouring, never on the instruction set or the thread count.
 // docs/performance.md measures the order against Box2D's plain greedy
 // colouring and against one colour per constraint.
+#include "world/grow_capacity.hpp"
 #include "world/parallel_thresholds.hpp"
 #include "world/step_stages.hpp"
 
@@ -475,10 +476,14 @@ void layoutGraph(WorldImpl& w, StepContext& ctx) {
     batch_at += (manifolds_in[static_cast<size_t>(c)] + kBatchLanes - 1) / kBatchLanes;
     gc.batch_end = batch_at;
   }
+  reserveGrowing(g.batches, static_cast<size_t>(batch_at));
   g.batches.resize(static_cast<size_t>(batch_at));
+  reserveGrowing(g.groups, static_cast<size_t>(group_at));
   g.groups.resize(static_cast<size_t>(group_at));
+  reserveGrowing(ctx.group_joint, static_cast<size_t>(group_at));
   ctx.group_joint.assign(static_cast<size_t>(group_at), 0);
   // Each manifold's lane, in level order within its colour.
+  reserveGrowing(ctx.lane_contact, static_cast<size_t>(batch_at) * kBatchLanes);
   ctx.lane_contact.assign(static_cast<size_t>(batch_at) * kBatchLanes, -1);
   std::vector<std::int32_t>& lane_fill = ctx.lane_fill;
   lane_fill.resize(static_cast<size_t>(colours));

@@ -4,6 +4,7 @@
 #include "cairn/error.hpp"
 #include "collision/aabb.hpp"
 #include "collision/narrowphase.hpp"
+#include "world/grow_capacity.hpp"
 #include "world/parallel_thresholds.hpp"
 #include "world/sorted_keys.hpp"
 #include "world/step_stages.hpp"
@@ -357,6 +358,13 @@ void collide(WorldImpl& w, StepContext& ctx) {
     //    with the same key and feature ids).
     std::swap(old_contacts_, contacts_);
     contacts_.clear();
+    // Room for as many contacts as last step made, so that the list does not
+    // double its way up (each doubling a copy into fresh memory, every page
+    // of it a fault: the second step of the 5,050-box pyramid, whose list
+    // is the one the first step left empty, faulted 5,100 times, 2,600
+    // with it). Not at the first step: there the growing list's freed
+    // blocks serve the islands and the row build (docs/performance.md).
+    reserveGrowing(contacts_, old_contacts_.size());
     const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
     // Last step's keys, read once and checked for order in their own
     // array (a walk over the contacts would read a 704-byte contact each).

@@ -6,14 +6,14 @@
 namespace cairn {
 
 Aabb shapeAabb(const ShapeDesc& s, const Transform& t) {
-  const Mat3 r = t.q.toRotationMatrix();
+  // The rotation matrix only where the box depends on it (not a sphere's).
   switch (s.type) {
     case ShapeType::Sphere: return Aabb::fromCenterHalf(t.p, Vec3::Constant(s.radius));
-    case ShapeType::Box: return Aabb::fromCenterHalf(t.p, r.cwiseAbs() * s.half_extents);
+    case ShapeType::Box: return Aabb::fromCenterHalf(t.p, t.q.toRotationMatrix().cwiseAbs() * s.half_extents);
     case ShapeType::Capsule:
-      return Aabb::fromCenterHalf(t.p, r.col(1).cwiseAbs() * s.half_height + Vec3::Constant(s.radius));
+      return Aabb::fromCenterHalf(t.p, t.q.toRotationMatrix().col(1).cwiseAbs() * s.half_height + Vec3::Constant(s.radius));
     case ShapeType::Cylinder: {
-      const Vec3 a = r.col(1);
+      const Vec3 a = t.q.toRotationMatrix().col(1);
       Vec3 half;
       for (int i = 0; i < 3; ++i)
         half[i] = s.half_height * std::abs(a[i]) + s.radius * std::sqrt(std::max(Real(0), 1 - a[i] * a[i]));

@@ -363,7 +363,8 @@ void collide(WorldImpl& w, StepContext& ctx) {
     // of it a fault: the second step of the 5,050-box pyramid, whose list
     // is the one the first step left empty, faulted 5,100 times, 2,600
     // with it). Not at the first step: there the growing list's freed
-    // blocks serve the islands and the row build (docs/performance.md).
+    // blocks serve the islands', the row build's, the solve's and the
+    // events' lists (docs/performance.md).
     reserveGrowing(contacts_, old_contacts_.size());
     const auto by_key = [](const Contact& x, const Contact& y) { return x.key() < y.key(); };
     // Last step's keys, read once and checked for order in their own

@@ -49,4 +49,11 @@ Aabb shapeAabb(const ShapeDesc& s, const Transform& t) {
   return Aabb{};
 }
 
+Aabb bodyShapeAabb(const ShapeDesc& shape, const Transform& body) {
+  // The composition's rotation is a quaternion product, a square root and
+  // a division: a third of the proxies' refit on chain-100's links.
+  if (shape.type == ShapeType::Sphere) return Aabb::fromCenterHalf(body.apply(shape.local.p), Vec3::Constant(shape.radius));
+  return shapeAabb(shape, body * shape.local);
+}
+
 }  // namespace cairn

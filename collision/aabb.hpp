@@ -103,6 +103,10 @@ inline void pushNearerLast(SegmentEntry* stack, int& top, SegmentEntry a, Segmen
 
 // World bounds of `shape` placed at `t` (t already includes shape.local).
 Aabb shapeAabb(const ShapeDesc& shape, const Transform& t);
+// World bounds of `shape` on a body at `body`: shapeAabb at body *
+// shape.local, to the bit, without composing the rotations where the box
+// does not depend on them (a sphere's is its centre's).
+Aabb bodyShapeAabb(const ShapeDesc& shape, const Transform& body);
 
 inline Aabb triangleAabb(const Vec3& a, const Vec3& b, const Vec3& c) {
   return Aabb{a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)};

@@ -31,7 +31,7 @@ void WorldImpl::registerShape(BodyId id, std::int32_t index_in_body) {
   ref.index = index_in_body;
   ref.alive = true;
   const ShapeDesc& shape = b.shapes[static_cast<size_t>(index_in_body)];
-  Aabb box = shapeAabb(shape, b.transform() * shape.local);
+  Aabb box = bodyShapeAabb(shape, b.transform());
   if (!box.isInfinite()) box = box.expanded(settings_.contact_margin);
   ref.proxy = broadphase_.createProxy(box, slot, Vec3::Zero(), id.index);  // a body's own shapes never pair
   proxy_fits_.resize(shapes_.size());  // the slot's box is fitted afresh
@@ -50,12 +50,7 @@ bool WorldImpl::fitProxy(std::size_t slot, Real h, Aabb& box) {
     return false;
   fit = {b.position, b.linear_velocity, b.orientation, h, margin, b.ccd};
   const ShapeDesc& shape = b.shapes[static_cast<size_t>(ref.index)];
-  // A sphere's box is its centre's: the composed rotation (a product, a
-  // square root and a division, a third of this function on chain-100's
-  // links) is not needed, and the centre is the composition's to the bit.
-  const Transform placed = shape.type == ShapeType::Sphere ? Transform{b.transform().apply(shape.local.p), b.orientation}
-                                                           : b.transform() * shape.local;
-  box = shapeAabb(shape, placed);
+  box = bodyShapeAabb(shape, b.transform());
   if (!box.isInfinite()) box = box.expanded(contactReach(b, margin, h));  // as registerShape does
   return true;
 }

@@ -99,6 +99,22 @@ TEST(CollisionSupport, WorldAabbIsTheBoxOfAxisSupports) {
   }
 }
 
+// A shape's box on a body is the box at the composed transform, to the
+// bit, whatever shortcut a shape type takes (a sphere's skips the
+// rotations): the broadphase's boxes, and so its pairs, do not move.
+TEST(CollisionSupport, BodyShapeAabbIsTheBoxAtTheComposedTransformExactly) {
+  std::mt19937 rng(11);
+  for (ShapeDesc s : convexShapes()) {
+    for (int k = 0; k < 50; ++k) {
+      s.local = randomTransform(rng);
+      const Transform body = randomTransform(rng);
+      const Aabb composed = shapeAabb(s, body * s.local), placed = bodyShapeAabb(s, body);
+      EXPECT_EQ(placed.lo, composed.lo) << shapeTypeName(s.type);
+      EXPECT_EQ(placed.hi, composed.hi) << shapeTypeName(s.type);
+    }
+  }
+}
+
 TEST(CollisionSupport, PlaneAabbIsInfiniteAndAxisAlignedPlaneBoundsItsAxis) {
   Transform t;
   t.p = Vec3(0, 2, 0);

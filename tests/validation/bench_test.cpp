@@ -136,15 +136,18 @@ TEST(BenchCommand, ShortRunOfTwoSmallScenesWritesTheDocumentedTable) {
   for (const std::string& c : documentedColumns()) EXPECT_NE(doc.find("`" + c + "`"), std::string::npos) << c;
 
   // The core check: each thread's share of one thread's multiply-add rate,
-  // at the start and the end. A share is a ratio of two times of the same
-  // work; above 1 only by timing noise (best of three each, a few percent),
-  // and above 0 unless a thread never ran.
+  // at the start and the end. A share is a ratio of two timings, so the
+  // test bounds only what does not depend on timing: it is a finite number
+  // above 0 (0 would mean a thread never ran). How far above 1 it may read
+  // depends on what else shares the cores during the one-thread reference
+  // (under `ctest -j2` another test can: 1.6 was seen), and timings are
+  // measured, never asserted.
   const auto manifest = nlohmann::json::parse(slurp(out + "/bench.json"));
   const auto& machine = manifest.at("machine");
   EXPECT_EQ(machine.at("core_check_threads").get<int>(), std::min(2, std::max(1, machine.at("cpus").get<int>())));
   for (const char* k : {"core_share_start", "core_share_end"}) {
+    EXPECT_TRUE(std::isfinite(machine.at(k).get<double>())) << k;
     EXPECT_GT(machine.at(k).get<double>(), 0) << k;
-    EXPECT_LT(machine.at(k).get<double>(), 1.5) << k;
   }
   const std::string md = slurp(out + "/bench.md");
   if (machine.at("cpus").get<int>() >= 2) {

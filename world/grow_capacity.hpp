@@ -23,4 +23,16 @@ void reserveGrowing(Vector& v, std::size_t n) {
   if (n > v.capacity()) v.reserve(std::max(n, 2 * v.capacity()));
 }
 
+// v.resize(n) and v.assign(n, value), the capacity grown as above first.
+template <class Vector>
+void resizeGrowing(Vector& v, std::size_t n) {
+  reserveGrowing(v, n);
+  v.resize(n);
+}
+template <class Vector, class T>
+void assignGrowing(Vector& v, std::size_t n, const T& value) {
+  reserveGrowing(v, n);
+  v.assign(n, value);
+}
+
 }  // namespace cairn::detail

@@ -476,15 +476,11 @@ void layoutGraph(WorldImpl& w, StepContext& ctx) {
     batch_at += (manifolds_in[static_cast<size_t>(c)] + kBatchLanes - 1) / kBatchLanes;
     gc.batch_end = batch_at;
   }
-  reserveGrowing(g.batches, static_cast<size_t>(batch_at));
-  g.batches.resize(static_cast<size_t>(batch_at));
-  reserveGrowing(g.groups, static_cast<size_t>(group_at));
-  g.groups.resize(static_cast<size_t>(group_at));
-  reserveGrowing(ctx.group_joint, static_cast<size_t>(group_at));
-  ctx.group_joint.assign(static_cast<size_t>(group_at), 0);
+  resizeGrowing(g.batches, static_cast<size_t>(batch_at));
+  resizeGrowing(g.groups, static_cast<size_t>(group_at));
+  assignGrowing(ctx.group_joint, static_cast<size_t>(group_at), 0);
   // Each manifold's lane, in level order within its colour.
-  reserveGrowing(ctx.lane_contact, static_cast<size_t>(batch_at) * kBatchLanes);
-  ctx.lane_contact.assign(static_cast<size_t>(batch_at) * kBatchLanes, -1);
+  assignGrowing(ctx.lane_contact, static_cast<size_t>(batch_at) * kBatchLanes, -1);
   std::vector<std::int32_t>& lane_fill = ctx.lane_fill;
   lane_fill.resize(static_cast<size_t>(colours));
   for (std::int32_t c = 0; c < colours; ++c) lane_fill[static_cast<size_t>(c)] = g.colours[static_cast<size_t>(c)].batch_begin * kBatchLanes;

@@ -1,7 +1,7 @@
 // The per-step lists' growth (world/grow_capacity.hpp): a list cleared and
 // sized whole every step, a little longer each time (a pile's contacts as
 // it lands), is allocated a logarithmic number of times, and holds exactly
-// what the resize or assign after the reservation makes.
+// what a plain resize or assign makes.
 #include "world/grow_capacity.hpp"
 
 #include <gtest/gtest.h>
@@ -39,11 +39,9 @@ TEST(GrowCapacity, AListSizedWholeEachStepAndGrowingByOneIsAllocatedLogarithmica
   for (int n = 1; n <= kSteps; ++n) {
     const auto size = static_cast<std::size_t>(n);
     assigned.clear();
-    reserveGrowing(assigned, size);
-    assigned.assign(size, -1);
+    assignGrowing(assigned, size, -1);
     resized.clear();
-    reserveGrowing(resized, size);
-    resized.resize(size);
+    resizeGrowing(resized, size);
   }
   // Doubling from one element: capacities 1, 2, 4, ... 2048, twelve
   // allocations a list. Reserving exactly n would make 2,000 each.
@@ -60,8 +58,7 @@ TEST(GrowCapacity, AListWithRoomEnoughKeepsItsAllocation) {
   std::vector<int> v(100, 7);
   const int* data = v.data();
   v.clear();
-  reserveGrowing(v, 50);
-  v.assign(50, 3);
+  assignGrowing(v, 50, 3);
   EXPECT_EQ(v.data(), data);
   EXPECT_EQ(v.capacity(), 100u);
 }

@@ -1142,6 +1142,50 @@ struct Kernel {
 
 #undef CAIRN_INLINE
 
+// The sweeps' kernels at the narrowest width that holds a batch's
+// manifolds. A colour's manifolds fill its batches from lane 0, so only its
+// last batch is partly empty, and a stack's many small colours make many
+// such batches (pyramid-20: 44 of its 111 batches hold four manifolds or
+// fewer, 25 of them two or fewer). A wide kernel works every lane of its
+// vector whether or not it holds a manifold; the narrower ones skip the
+// empty groups of lanes. Every width does the same arithmetic per lane
+// (above), so a batch gives the same bits at any of them.
+template <int Wide>
+struct Narrowed {
+  // The narrowest of 2, 4 and Wide lanes that holds every manifold of b.
+  static inline int width(const ContactBatch& b) {
+    int used = 0;
+    for (int l = 0; l < kBatchLanes; ++l)
+      if (b.count[l] > 0) used = l + 1;
+    return used <= 2 ? 2 : used <= 4 && Wide > 4 ? 4 : Wide;
+  }
+  // call(width, first, last) over the runs of consecutive batches of one width.
+  template <class Call>
+  static inline void runs(const ContactBatch* batches, int begin, int end, Call&& call) {
+    for (int i = begin; i < end;) {
+      const int w = width(batches[i]);
+      int j = i + 1;
+      while (j < end && width(batches[j]) == w) ++j;
+      call(w, i, j);
+      i = j;
+    }
+  }
+  template <void (*F2)(ContactBatch*, int, int, double*, const ContactSweepParams&),
+            void (*F4)(ContactBatch*, int, int, double*, const ContactSweepParams&),
+            void (*FW)(ContactBatch*, int, int, double*, const ContactSweepParams&)>
+  static void sweep(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p) {
+    runs(batches, begin, end, [&](int w, int i, int j) { (w == 2 ? F2 : w == 4 ? F4 : FW)(batches, i, j, bodies, p); });
+  }
+  static void momentum(ContactBatch* batches, int begin, int end, double* bodies, const double* island_beta,
+                       const ContactSweepParams& p) {
+    runs(batches, begin, end, [&](int w, int i, int j) {
+      if (w == 2) Kernel<2>::momentum(batches, i, j, bodies, island_beta, p);
+      else if (w == 4) Kernel<(Wide > 4 ? 4 : Wide)>::momentum(batches, i, j, bodies, island_beta, p);
+      else Kernel<Wide>::momentum(batches, i, j, bodies, island_beta, p);
+    });
+  }
+};
+
 }  // namespace
 
 // The table of this unit's kernels, a constant: a table filled at run time
@@ -1149,9 +1193,20 @@ struct Kernel {
 // what it supports (the units define it constinit).
 constexpr ContactKernels makeKernels(const char* name) {
   using K = Kernel<CAIRN_KERNEL_LANES>;
-  return ContactKernels{name,         CAIRN_KERNEL_LANES, &K::warmStart,   &K::solveNormals,
-                        &K::solveFriction, &K::momentum, &K::solveBias, &K::restitution,
-                        &K::fill,     &K::refresh, &JointKernel<CAIRN_KERNEL_LANES>::solveLanes,
+  using K2 = Kernel<2>;
+  using K4 = Kernel<(CAIRN_KERNEL_LANES > 4 ? 4 : CAIRN_KERNEL_LANES)>;
+  using N = Narrowed<CAIRN_KERNEL_LANES>;
+  return ContactKernels{name,
+                        CAIRN_KERNEL_LANES,
+                        &N::template sweep<&K2::warmStart, &K4::warmStart, &K::warmStart>,
+                        &N::template sweep<&K2::solveNormals, &K4::solveNormals, &K::solveNormals>,
+                        &N::template sweep<&K2::solveFriction, &K4::solveFriction, &K::solveFriction>,
+                        &N::momentum,
+                        &N::template sweep<&K2::solveBias, &K4::solveBias, &K::solveBias>,
+                        &N::template sweep<&K2::restitution, &K4::restitution, &K::restitution>,
+                        &K::fill,
+                        &K::refresh,
+                        &JointKernel<CAIRN_KERNEL_LANES>::solveLanes,
                         &JointKernel<CAIRN_KERNEL_LANES>::momentumLanes,
                         &JointKernel<CAIRN_KERNEL_LANES>::biasLanes};
 }

@@ -6,8 +6,10 @@
 // a kernel loads a field of four or eight manifolds with one vector load.
 // The layout is the same whatever the instruction set: the AVX-512 kernel
 // reads eight lanes at a time, the AVX2 kernel four, the portable kernel
-// one, and all do the same arithmetic per lane in the same order, so their
-// results are bit-identical (docs/performance.md, "Determinism").
+// two (a batch whose manifolds fit in fewer lanes is swept at the narrower
+// width: contact_kernel_impl.hpp, Narrowed), and all do the same
+// arithmetic per lane in the same order, so their results are
+// bit-identical (docs/performance.md, "SIMD lanes").
 //
 // Per manifold only what the solver reads, in the spirit of Box2D v3's
 // b2ContactConstraintSIMD and Bullet's btSolverConstraint: the two bodies,

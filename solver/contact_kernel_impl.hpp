@@ -1154,6 +1154,7 @@ template <int Wide>
 struct Narrowed {
   // The narrowest of 2, 4 and Wide lanes that holds every manifold of b.
   static inline int width(const ContactBatch& b) {
+    if (Wide == 2) return 2;  // the portable table: nothing narrower
     int used = 0;
     for (int l = 0; l < kBatchLanes; ++l)
       if (b.count[l] > 0) used = l + 1;

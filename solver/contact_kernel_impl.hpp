@@ -1171,19 +1171,11 @@ struct Narrowed {
       i = j;
     }
   }
-  template <void (*F2)(ContactBatch*, int, int, double*, const ContactSweepParams&),
-            void (*F4)(ContactBatch*, int, int, double*, const ContactSweepParams&),
-            void (*FW)(ContactBatch*, int, int, double*, const ContactSweepParams&)>
-  static void sweep(ContactBatch* batches, int begin, int end, double* bodies, const ContactSweepParams& p) {
-    runs(batches, begin, end, [&](int w, int i, int j) { (w == 2 ? F2 : w == 4 ? F4 : FW)(batches, i, j, bodies, p); });
-  }
-  static void momentum(ContactBatch* batches, int begin, int end, double* bodies, const double* island_beta,
-                       const ContactSweepParams& p) {
-    runs(batches, begin, end, [&](int w, int i, int j) {
-      if (w == 2) Kernel<2>::momentum(batches, i, j, bodies, island_beta, p);
-      else if (w == 4) Kernel<(Wide > 4 ? 4 : Wide)>::momentum(batches, i, j, bodies, island_beta, p);
-      else Kernel<Wide>::momentum(batches, i, j, bodies, island_beta, p);
-    });
+  // One of the table's sweeps (its arguments after the batch range are
+  // the kernels' own: momentum's carry the islands' betas).
+  template <auto F2, auto F4, auto FW, class... Args>
+  static void sweep(ContactBatch* batches, int begin, int end, Args... args) {
+    runs(batches, begin, end, [&](int w, int i, int j) { (w == 2 ? F2 : w == 4 ? F4 : FW)(batches, i, j, args...); });
   }
 };
 
@@ -1202,7 +1194,7 @@ constexpr ContactKernels makeKernels(const char* name) {
                         &N::template sweep<&K2::warmStart, &K4::warmStart, &K::warmStart>,
                         &N::template sweep<&K2::solveNormals, &K4::solveNormals, &K::solveNormals>,
                         &N::template sweep<&K2::solveFriction, &K4::solveFriction, &K::solveFriction>,
-                        &N::momentum,
+                        &N::template sweep<&K2::momentum, &K4::momentum, &K::momentum>,
                         &N::template sweep<&K2::solveBias, &K4::solveBias, &K::solveBias>,
                         &N::template sweep<&K2::restitution, &K4::restitution, &K::restitution>,
                         &K::fill,

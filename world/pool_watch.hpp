@@ -32,9 +32,16 @@
 // pool sits out kNoGainFirst steps, twice as many each time it is found
 // not paying again (up to kNoGainMost), and is judged again on its
 // kSample steps after each return. Where it pays, the next probe comes
-// four times as many steps later (up to kProbeMost): a probe's steps alone
-// are what the rule costs a scene whose pool pays (two probes, 10 of the
-// 5,050-box pyramid's first 100 steps). Steps are compared only
+// four times as many steps later (up to kProbeMost), and no sooner than
+// its cost allows: a probe's steps alone are what the rule costs a scene
+// whose pool pays, their time beyond the pool's is held to kProbeShare of
+// the pool's time until the next probe, so the wider the pool's margin the
+// rarer the probes (a pool twice as fast as one thread is probed 300 pool
+// steps apart at first, not 32; one 5% faster as before). A probe
+// also ends as soon as its verdict is sealed: once its steps alone so far
+// took kSoloBetter of the pool's kSample steps, no step alone after them
+// can make the steps alone the faster (the same verdict the whole probe
+// would give, a step or two sooner). Steps are compared only
 // when they did about the same work (rows within kSameWork of each other),
 // the pool's only when it was handed a loop, and never the first step on
 // a pool back from sitting out (its workers wake from sleep).
@@ -44,6 +51,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 namespace cairn {
@@ -79,6 +87,7 @@ class PoolWatch {
   static constexpr int kNoGainMost = 256;
   static constexpr double kSoloBetter = 0.97;
   static constexpr double kSameWork = 1.1;
+  static constexpr double kProbeShare = 0.01;
 
   // Before a step: whether it runs on the pool (false: on the calling
   // thread alone, one of the steps sat out).
@@ -120,6 +129,7 @@ class PoolWatch {
     if (--to_probe_ > 0) return false;
     solo_steps_ = kSample + 1;
     solo_count_ = 0;
+    alone_taken_ = 0;
     first_alone_ = true;
     aside_ = AloneReason::Probe;
     return true;
@@ -129,15 +139,17 @@ class PoolWatch {
   // the next startStep unless this ends a probe that found no gain.
   void endSoloStep(double seconds, int work) {
     if (aside_ == AloneReason::LostCores || aside_ == AloneReason::None) return;  // shared cores' times say nothing
+    ++alone_taken_;
     if (first_alone_) first_alone_ = false;  // the pool's data still in the other cores' caches: not a sample
     else solo_[static_cast<size_t>(solo_count_++ % kSample)] = {seconds, work};
+    if (aside_ == AloneReason::Probe && poolPaysWhateverFollows()) solo_steps_ = 0;
     if (solo_steps_ > 0) return;
     if (aside_ == AloneReason::Probe && solo_count_ >= kSample && soloBetter()) {
       setAsideForNoGain();
       return;
     }
     if (aside_ == AloneReason::Probe) {
-      to_probe_ = probe_gap_.take();
+      to_probe_ = std::max(probe_gap_.take(), gapForCost());
     } else {
       judging_ = true;
     }
@@ -161,19 +173,58 @@ class PoolWatch {
   // Whether the last kSample steps alone took less than kSoloBetter of the
   // last kSample pool steps' time, all of them about the same work.
   bool soloBetter() const {
-    if (pool_count_ < kSample || solo_count_ < kSample) return false;
-    int least = pool_[0].work, most = pool_[0].work;
+    if (solo_count_ < kSample) return false;
+    const Taken t = taken();
+    return t.comparable && t.solo < kSoloBetter * t.pool;
+  }
+
+  // The pool's latest kSample steps and the steps alone sampled so far (up
+  // to kSample): the seconds of each summed, and whether all of them did
+  // about the same work.
+  struct Taken {
     double pool = 0, solo = 0;
+    bool comparable = false;
+  };
+  Taken taken() const {
+    Taken t;
+    if (pool_count_ < kSample || solo_count_ == 0) return t;
+    const int n = std::min(solo_count_, kSample);
+    int least = pool_[0].work, most = pool_[0].work;
     for (int k = 0; k < kSample; ++k) {
       const Sample& p = pool_[static_cast<size_t>(k)];
-      const Sample& s = solo_[static_cast<size_t>(k)];
-      least = std::min({least, p.work, s.work});
-      most = std::max({most, p.work, s.work});
-      pool += p.seconds;
-      solo += s.seconds;
+      least = std::min(least, p.work);
+      most = std::max(most, p.work);
+      t.pool += p.seconds;
     }
-    if (double(most) > kSameWork * double(least)) return false;
-    return solo < kSoloBetter * pool;
+    for (int k = 0; k < n; ++k) {
+      const Sample& s = solo_[static_cast<size_t>(k)];
+      least = std::min(least, s.work);
+      most = std::max(most, s.work);
+      t.solo += s.seconds;
+    }
+    t.comparable = double(most) <= kSameWork * double(least);
+    return t;
+  }
+
+  // A probe short of kSample steps alone whose steps so far already took
+  // kSoloBetter of the pool's kSample: the steps alone cannot be found the
+  // faster, and the pool comes back (after no verdict as well).
+  bool poolPaysWhateverFollows() const {
+    if (solo_count_ == 0 || solo_count_ >= kSample) return false;
+    const Taken t = taken();
+    return t.pool > 0 && t.solo >= kSoloBetter * t.pool;
+  }
+
+  // After a probe that found the pool paying: the pool steps until the
+  // next probe for the probe's steps alone to cost no more, beyond the
+  // pool's time, than kProbeShare of the pool's time until then (0 when the
+  // probe's steps cannot be compared with the pool's).
+  int gapForCost() const {
+    const Taken t = taken();
+    if (!t.comparable || t.pool <= 0) return 0;
+    const double ratio = (t.solo / std::min(solo_count_, kSample)) / (t.pool / kSample);
+    const double gap = std::ceil(double(alone_taken_) * (ratio - 1) / kProbeShare);
+    return gap >= kProbeMost ? kProbeMost : std::max(0, static_cast<int>(gap));
   }
 
   bool setAsideForNoGain() {
@@ -189,6 +240,7 @@ class PoolWatch {
   AloneReason aside_ = AloneReason::None;
   std::array<Sample, kSample> pool_{}, solo_{};  // the latest steps on the pool and alone, as rings
   int pool_count_ = 0, solo_count_ = 0;          // samples taken since the rings were last emptied
+  int alone_taken_ = 0;                          // steps alone in the present probe, its first included
   int to_probe_ = kProbeFirst;                   // pool steps until the next probe
   GrowingLength probe_gap_{4 * kProbeFirst, 4, kProbeMost};  // pool steps between the probes after the first
   GrowingLength no_gain_run_{kNoGainFirst, 2, kNoGainMost};  // the runs alone when the pool is found not paying

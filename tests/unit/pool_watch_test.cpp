@@ -114,13 +114,15 @@ TEST(PoolWatch, AloneFasterSetsThePoolAsideForLongerEachTime) {
   EXPECT_EQ(runs, expected);
 }
 
-// The pool 20% faster: each probe of 5 steps finds it paying, and the next
+// The pool 5% faster: each probe of 5 steps finds it paying, and the next
 // comes four times as many pool steps later (a wake-up step, 4 to fill the
-// ring again, then the interval), up to kProbeMost.
+// ring again, then the interval), up to kProbeMost. (A probe's 5 steps at
+// 5% over the pool's time cost under kProbeShare of 32 pool steps: the
+// cost sets no longer gap here.)
 TEST(PoolWatch, ThePoolPayingIsProbedFourTimesAsRarelyEachTime) {
   constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
   PoolWatch watch;
-  const std::vector<RunAlone> runs = timedRuns(watch, 3000, 0.8, 1.0);
+  const std::vector<RunAlone> runs = timedRuns(watch, 3000, 0.95, 1.0);
   std::vector<RunAlone> expected{{kProbe, 5, AloneReason::Probe}};
   int at = kProbe + 5;
   for (int every = 4 * PoolWatch::kProbeFirst;; every = std::min(4 * every, PoolWatch::kProbeMost)) {
@@ -131,6 +133,38 @@ TEST(PoolWatch, ThePoolPayingIsProbedFourTimesAsRarelyEachTime) {
   }
   EXPECT_EQ(runs, expected);
   EXPECT_EQ(runs.back().first - runs[runs.size() - 2].first, 5 + 1 + 3 + PoolWatch::kProbeMost);
+}
+
+// The pool twice as fast: a probe ends after 3 steps alone, the second
+// sample making the steps alone's time (2.0) reach kSoloBetter of the
+// pool's four steps (1.94), so that no later sample could turn the
+// verdict. The 3 steps cost 3 pool steps' time beyond the pool's, which
+// is kProbeShare (1%) of 300 pool steps: the next probe comes 300 pool
+// steps later, not 32, and again (not 128), then the four-fold gaps take
+// over (512, then kProbeMost).
+TEST(PoolWatch, AFarFasterPoolIsProbedBrieflyAndSoRarelyThatProbesCostAHundredthOfItsTime) {
+  constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
+  PoolWatch watch;
+  const std::vector<RunAlone> runs = timedRuns(watch, 3000, 0.5, 1.0);
+  std::vector<RunAlone> expected{{kProbe, 3, AloneReason::Probe}};
+  int at = kProbe + 3;
+  for (const int every : {300, 300, 512, 1024, 1024}) {
+    at += 1 + 3 + every;
+    if (at >= 3000) break;
+    expected.push_back({at, 3, AloneReason::Probe});
+    at += 3;
+  }
+  EXPECT_EQ(runs, expected);
+}
+
+// A probe ends early only on a sealed verdict: with the pool 1.2 times as
+// fast, three samples alone (3.0) are short of kSoloBetter of the pool's
+// four (0.97 x 3.33 = 3.23), so the probe takes its 5 steps.
+TEST(PoolWatch, AProbeWhoseVerdictIsOpenTakesAllItsSteps) {
+  constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
+  PoolWatch watch;
+  const std::vector<RunAlone> runs = timedRuns(watch, kProbe + 6, 1.0 / 1.2, 1.0);
+  EXPECT_EQ(runs, (std::vector<RunAlone>{{kProbe, 5, AloneReason::Probe}}));
 }
 
 // Alone within 3% of the pool (kSoloBetter): the pool stays.

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 namespace cairn {
@@ -114,24 +115,35 @@ TEST(PoolWatch, AloneFasterSetsThePoolAsideForLongerEachTime) {
   EXPECT_EQ(runs, expected);
 }
 
+// The probes of a pool that pays, within `steps`: the first after
+// kProbeFirst + 3 pool steps (pool steps 0, 1, 2 fill the ring with the
+// first decrement's), each `length` steps alone, the next after a wake-up
+// step, 3 more to fill the ring again (the fourth is the interval's
+// first) and gap(k) pool steps, k counting the gaps from 0.
+template <class Gap>
+std::vector<RunAlone> probesOfAPoolThatPays(int steps, int length, Gap&& gap) {
+  std::vector<RunAlone> expected;
+  for (int at = 3 + PoolWatch::kProbeFirst, k = 0; at < steps; at += length + 1 + 3 + gap(k++))
+    expected.push_back({at, length, AloneReason::Probe});
+  return expected;
+}
+
+// The four-fold gaps: 4 kProbeFirst pool steps after the first probe,
+// four times as many after each next, up to kProbeMost.
+int fourFoldGap(int k) {
+  int gap = 4 * PoolWatch::kProbeFirst;
+  for (int i = 0; i < k && gap < PoolWatch::kProbeMost; ++i) gap = std::min(4 * gap, PoolWatch::kProbeMost);
+  return gap;
+}
+
 // The pool 5% faster: each probe of 5 steps finds it paying, and the next
-// comes four times as many pool steps later (a wake-up step, 4 to fill the
-// ring again, then the interval), up to kProbeMost. (A probe's 5 steps at
-// 5% over the pool's time cost under kProbeShare of 32 pool steps: the
-// cost sets no longer gap here.)
+// comes four times as many pool steps later, up to kProbeMost. (A probe's
+// 5 steps at 5% over the pool's time cost under kProbeShare of 32 pool
+// steps: the cost sets no longer gap here.)
 TEST(PoolWatch, ThePoolPayingIsProbedFourTimesAsRarelyEachTime) {
-  constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
   PoolWatch watch;
   const std::vector<RunAlone> runs = timedRuns(watch, 3000, 0.95, 1.0);
-  std::vector<RunAlone> expected{{kProbe, 5, AloneReason::Probe}};
-  int at = kProbe + 5;
-  for (int every = 4 * PoolWatch::kProbeFirst;; every = std::min(4 * every, PoolWatch::kProbeMost)) {
-    at += 1 + 3 + every;
-    if (at >= 3000) break;
-    expected.push_back({at, 5, AloneReason::Probe});
-    at += 5;
-  }
-  EXPECT_EQ(runs, expected);
+  EXPECT_EQ(runs, probesOfAPoolThatPays(3000, 5, fourFoldGap));
   EXPECT_EQ(runs.back().first - runs[runs.size() - 2].first, 5 + 1 + 3 + PoolWatch::kProbeMost);
 }
 
@@ -143,18 +155,10 @@ TEST(PoolWatch, ThePoolPayingIsProbedFourTimesAsRarelyEachTime) {
 // steps later, not 32, and again (not 128), then the four-fold gaps take
 // over (512, then kProbeMost).
 TEST(PoolWatch, AFarFasterPoolIsProbedBrieflyAndSoRarelyThatProbesCostAHundredthOfItsTime) {
-  constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
   PoolWatch watch;
   const std::vector<RunAlone> runs = timedRuns(watch, 3000, 0.5, 1.0);
-  std::vector<RunAlone> expected{{kProbe, 3, AloneReason::Probe}};
-  int at = kProbe + 3;
-  for (const int every : {300, 300, 512, 1024, 1024}) {
-    at += 1 + 3 + every;
-    if (at >= 3000) break;
-    expected.push_back({at, 3, AloneReason::Probe});
-    at += 3;
-  }
-  EXPECT_EQ(runs, expected);
+  EXPECT_EQ(runs, probesOfAPoolThatPays(3000, 3, [](int k) { return std::max(300, fourFoldGap(k)); }));
+  EXPECT_EQ(runs[1].first - runs[0].first, 3 + 1 + 3 + 300);
 }
 
 // A probe ends early only on a sealed verdict: with the pool 1.2 times as

@@ -129,7 +129,6 @@ class PoolWatch {
     if (--to_probe_ > 0) return false;
     solo_steps_ = kSample + 1;
     solo_count_ = 0;
-    alone_taken_ = 0;
     first_alone_ = true;
     aside_ = AloneReason::Probe;
     return true;
@@ -139,7 +138,6 @@ class PoolWatch {
   // the next startStep unless this ends a probe that found no gain.
   void endSoloStep(double seconds, int work) {
     if (aside_ == AloneReason::LostCores || aside_ == AloneReason::None) return;  // shared cores' times say nothing
-    ++alone_taken_;
     if (first_alone_) first_alone_ = false;  // the pool's data still in the other cores' caches: not a sample
     else solo_[static_cast<size_t>(solo_count_++ % kSample)] = {seconds, work};
     if (aside_ == AloneReason::Probe && poolPaysWhateverFollows()) solo_steps_ = 0;
@@ -216,14 +214,15 @@ class PoolWatch {
   }
 
   // After a probe that found the pool paying: the pool steps until the
-  // next probe for the probe's steps alone to cost no more, beyond the
-  // pool's time, than kProbeShare of the pool's time until then (0 when the
-  // probe's steps cannot be compared with the pool's).
+  // next probe for the probe's steps alone (its samples and its first
+  // step) to cost no more, beyond the pool's time, than kProbeShare of the
+  // pool's time until then (0 when the probe's steps cannot be compared
+  // with the pool's).
   int gapForCost() const {
     const Taken t = taken();
     if (!t.comparable || t.pool <= 0) return 0;
-    const double ratio = (t.solo / std::min(solo_count_, kSample)) / (t.pool / kSample);
-    const double gap = std::ceil(double(alone_taken_) * (ratio - 1) / kProbeShare);
+    const double ratio = (t.solo / solo_count_) / (t.pool / kSample);  // a probe takes at most kSample samples
+    const double gap = std::ceil(double(solo_count_ + 1) * (ratio - 1) / kProbeShare);
     return gap >= kProbeMost ? kProbeMost : std::max(0, static_cast<int>(gap));
   }
 
@@ -240,7 +239,6 @@ class PoolWatch {
   AloneReason aside_ = AloneReason::None;
   std::array<Sample, kSample> pool_{}, solo_{};  // the latest steps on the pool and alone, as rings
   int pool_count_ = 0, solo_count_ = 0;          // samples taken since the rings were last emptied
-  int alone_taken_ = 0;                          // steps alone in the present probe, its first included
   int to_probe_ = kProbeFirst;                   // pool steps until the next probe
   GrowingLength probe_gap_{4 * kProbeFirst, 4, kProbeMost};  // pool steps between the probes after the first
   GrowingLength no_gain_run_{kNoGainFirst, 2, kNoGainMost};  // the runs alone when the pool is found not paying

@@ -132,7 +132,7 @@ std::vector<RunAlone> probesOfAPoolThatPays(int steps, int length, Gap&& gap) {
 // four times as many after each next, up to kProbeMost.
 int fourFoldGap(int k) {
   int gap = 4 * PoolWatch::kProbeFirst;
-  for (int i = 0; i < k && gap < PoolWatch::kProbeMost; ++i) gap = std::min(4 * gap, PoolWatch::kProbeMost);
+  for (int i = 0; i < k; ++i) gap = std::min(4 * gap, PoolWatch::kProbeMost);
   return gap;
 }
 
@@ -165,10 +165,10 @@ TEST(PoolWatch, AFarFasterPoolIsProbedBrieflyAndSoRarelyThatProbesCostAHundredth
 // fast, three samples alone (3.0) are short of kSoloBetter of the pool's
 // four (0.97 x 3.33 = 3.23), so the probe takes its 5 steps.
 TEST(PoolWatch, AProbeWhoseVerdictIsOpenTakesAllItsSteps) {
-  constexpr int kProbe = 3 + PoolWatch::kProbeFirst;
+  constexpr int kSteps = 3 + PoolWatch::kProbeFirst + 6;  // the first probe and one step after it
   PoolWatch watch;
-  const std::vector<RunAlone> runs = timedRuns(watch, kProbe + 6, 1.0 / 1.2, 1.0);
-  EXPECT_EQ(runs, (std::vector<RunAlone>{{kProbe, 5, AloneReason::Probe}}));
+  const std::vector<RunAlone> runs = timedRuns(watch, kSteps, 1.0 / 1.2, 1.0);
+  EXPECT_EQ(runs, probesOfAPoolThatPays(kSteps, 5, fourFoldGap));
 }
 
 // Alone within 3% of the pool (kSoloBetter): the pool stays.

@@ -163,57 +163,82 @@ struct Kernel {
 
   // --- Gathering and scattering the bodies' velocities. A body is 8
   // doubles (v, w, two spare); for W bodies the kernel needs the six
-  // velocity components as six vectors: a transpose.
+  // velocity components as six vectors: a transpose. The scatter writes a
+  // body back as whole vectors too, the transpose run the other way (it is
+  // its own inverse) with zeros for the spare pair, which is never anything
+  // else (solver/solver_body.hpp). The next visit to read the body (the
+  // friction visit after the normal one, the next colour's) loads it as
+  // whole vectors: from six scalar stores the processor cannot forward
+  // such a load, which then waits for the stores to reach the cache;
+  // from stores of the load's own size and place it can
+  // (docs/performance.md, "Now: bodies written back as whole lines").
+#if defined(__AVX512F__)
+  // 8 x 8 transpose of doubles in three stages of two-lane, four-lane and
+  // 128-bit shuffles: out[k] holds element k of in[0..7].
+  static inline __attribute__((always_inline)) void transpose8(const __m512d* in, __m512d* out) {
+    const __m512d t0 = _mm512_unpacklo_pd(in[0], in[1]), t1 = _mm512_unpackhi_pd(in[0], in[1]);
+    const __m512d t2 = _mm512_unpacklo_pd(in[2], in[3]), t3 = _mm512_unpackhi_pd(in[2], in[3]);
+    const __m512d t4 = _mm512_unpacklo_pd(in[4], in[5]), t5 = _mm512_unpackhi_pd(in[4], in[5]);
+    const __m512d t6 = _mm512_unpacklo_pd(in[6], in[7]), t7 = _mm512_unpackhi_pd(in[6], in[7]);
+    const __m512i lo = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0), hi = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
+    const __m512d u0 = _mm512_permutex2var_pd(t0, lo, t2), u1 = _mm512_permutex2var_pd(t1, lo, t3);
+    const __m512d u2 = _mm512_permutex2var_pd(t0, hi, t2), u3 = _mm512_permutex2var_pd(t1, hi, t3);
+    const __m512d u4 = _mm512_permutex2var_pd(t4, lo, t6), u5 = _mm512_permutex2var_pd(t5, lo, t7);
+    const __m512d u6 = _mm512_permutex2var_pd(t4, hi, t6), u7 = _mm512_permutex2var_pd(t5, hi, t7);
+    const __m512i a = _mm512_set_epi64(11, 10, 9, 8, 3, 2, 1, 0), c = _mm512_set_epi64(15, 14, 13, 12, 7, 6, 5, 4);
+    out[0] = _mm512_permutex2var_pd(u0, a, u4);
+    out[1] = _mm512_permutex2var_pd(u1, a, u5);
+    out[2] = _mm512_permutex2var_pd(u2, a, u6);
+    out[3] = _mm512_permutex2var_pd(u3, a, u7);
+    out[4] = _mm512_permutex2var_pd(u0, c, u4);
+    out[5] = _mm512_permutex2var_pd(u1, c, u5);
+    out[6] = _mm512_permutex2var_pd(u2, c, u6);
+    out[7] = _mm512_permutex2var_pd(u3, c, u7);
+  }
+#endif
+#if defined(__AVX2__)
+  // 4 x 4 transpose of doubles: out[k] holds element k of in[0..3].
+  static inline __attribute__((always_inline)) void transpose4(const __m256d* in, __m256d* out) {
+    const __m256d a0 = _mm256_unpacklo_pd(in[0], in[1]), a1 = _mm256_unpackhi_pd(in[0], in[1]);
+    const __m256d a2 = _mm256_unpacklo_pd(in[2], in[3]), a3 = _mm256_unpackhi_pd(in[2], in[3]);
+    out[0] = _mm256_permute2f128_pd(a0, a2, 0x20);
+    out[1] = _mm256_permute2f128_pd(a1, a3, 0x20);
+    out[2] = _mm256_permute2f128_pd(a0, a2, 0x31);
+    out[3] = _mm256_permute2f128_pd(a1, a3, 0x31);
+  }
+#endif
+
   CAIRN_INLINE void gather1(const double* bodies, const std::int32_t* idx, V3& v, V3& w) {
 #if defined(__AVX512F__)
     if constexpr (W == 8) {
-      __m512d r[8];
+      __m512d r[8], c[8];
       for (int i = 0; i < 8; ++i) r[i] = _mm512_loadu_pd(bodies + 8 * static_cast<long>(idx[i]));
-      // 8 x 8 transpose in three stages of two-lane, four-lane and 128-bit shuffles.
-      const __m512d t0 = _mm512_unpacklo_pd(r[0], r[1]), t1 = _mm512_unpackhi_pd(r[0], r[1]);
-      const __m512d t2 = _mm512_unpacklo_pd(r[2], r[3]), t3 = _mm512_unpackhi_pd(r[2], r[3]);
-      const __m512d t4 = _mm512_unpacklo_pd(r[4], r[5]), t5 = _mm512_unpackhi_pd(r[4], r[5]);
-      const __m512d t6 = _mm512_unpacklo_pd(r[6], r[7]), t7 = _mm512_unpackhi_pd(r[6], r[7]);
-      const __m512i lo = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0), hi = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
-      const __m512d u0 = _mm512_permutex2var_pd(t0, lo, t2), u1 = _mm512_permutex2var_pd(t1, lo, t3);
-      const __m512d u2 = _mm512_permutex2var_pd(t0, hi, t2), u3 = _mm512_permutex2var_pd(t1, hi, t3);
-      const __m512d u4 = _mm512_permutex2var_pd(t4, lo, t6), u5 = _mm512_permutex2var_pd(t5, lo, t7);
-      const __m512d u6 = _mm512_permutex2var_pd(t4, hi, t6), u7 = _mm512_permutex2var_pd(t5, hi, t7);
-      const __m512i a = _mm512_set_epi64(11, 10, 9, 8, 3, 2, 1, 0), c = _mm512_set_epi64(15, 14, 13, 12, 7, 6, 5, 4);
-      // Column k holds component k of the eight bodies.
-      const __m512d c0 = _mm512_permutex2var_pd(u0, a, u4), c1 = _mm512_permutex2var_pd(u1, a, u5);
-      const __m512d c2 = _mm512_permutex2var_pd(u2, a, u6), c3 = _mm512_permutex2var_pd(u3, a, u7);
-      const __m512d c4 = _mm512_permutex2var_pd(u0, c, u4), c5 = _mm512_permutex2var_pd(u1, c, u5);
-      __builtin_memcpy(&v.x, &c0, 64);
-      __builtin_memcpy(&v.y, &c1, 64);
-      __builtin_memcpy(&v.z, &c2, 64);
-      __builtin_memcpy(&w.x, &c3, 64);
-      __builtin_memcpy(&w.y, &c4, 64);
-      __builtin_memcpy(&w.z, &c5, 64);
+      transpose8(r, c);  // c[k]: component k of the eight bodies
+      __builtin_memcpy(&v.x, &c[0], 64);
+      __builtin_memcpy(&v.y, &c[1], 64);
+      __builtin_memcpy(&v.z, &c[2], 64);
+      __builtin_memcpy(&w.x, &c[3], 64);
+      __builtin_memcpy(&w.y, &c[4], 64);
+      __builtin_memcpy(&w.z, &c[5], 64);
       return;
     }
 #endif
 #if defined(__AVX2__)
     if constexpr (W == 4) {
-      __m256d lo[4], hi[4];
+      __m256d lo[4], hi[4], c[8];
       for (int i = 0; i < 4; ++i) {
         const double* p = bodies + 8 * static_cast<long>(idx[i]);
         lo[i] = _mm256_loadu_pd(p);      // vx vy vz wx
         hi[i] = _mm256_loadu_pd(p + 4);  // wy wz s s
       }
-      const __m256d a0 = _mm256_unpacklo_pd(lo[0], lo[1]), a1 = _mm256_unpackhi_pd(lo[0], lo[1]);
-      const __m256d a2 = _mm256_unpacklo_pd(lo[2], lo[3]), a3 = _mm256_unpackhi_pd(lo[2], lo[3]);
-      const __m256d c0 = _mm256_permute2f128_pd(a0, a2, 0x20), c1 = _mm256_permute2f128_pd(a1, a3, 0x20);
-      const __m256d c2 = _mm256_permute2f128_pd(a0, a2, 0x31), c3 = _mm256_permute2f128_pd(a1, a3, 0x31);
-      const __m256d b0 = _mm256_unpacklo_pd(hi[0], hi[1]), b1 = _mm256_unpackhi_pd(hi[0], hi[1]);
-      const __m256d b2 = _mm256_unpacklo_pd(hi[2], hi[3]), b3 = _mm256_unpackhi_pd(hi[2], hi[3]);
-      const __m256d c4 = _mm256_permute2f128_pd(b0, b2, 0x20), c5 = _mm256_permute2f128_pd(b1, b3, 0x20);
-      __builtin_memcpy(&v.x, &c0, 32);
-      __builtin_memcpy(&v.y, &c1, 32);
-      __builtin_memcpy(&v.z, &c2, 32);
-      __builtin_memcpy(&w.x, &c3, 32);
-      __builtin_memcpy(&w.y, &c4, 32);
-      __builtin_memcpy(&w.z, &c5, 32);
+      transpose4(lo, c);
+      transpose4(hi, c + 4);
+      __builtin_memcpy(&v.x, &c[0], 32);
+      __builtin_memcpy(&v.y, &c[1], 32);
+      __builtin_memcpy(&v.z, &c[2], 32);
+      __builtin_memcpy(&w.x, &c[3], 32);
+      __builtin_memcpy(&w.y, &c[4], 32);
+      __builtin_memcpy(&w.z, &c[5], 32);
       return;
     }
 #endif
@@ -235,11 +260,52 @@ struct Kernel {
 
   // Writes back only dynamic bodies of the lanes in `write`: static and
   // kinematic ones are read only, so nothing (not even a NaN) reaches
-  // another island through them.
+  // another island through them. Lanes are written in order, as a body
+  // twice in one vector (never in a colour's batch) would be by scalars.
+  static inline bool writes(const std::int32_t* idx, int i, int dynamic_end, M write) {
+    return write[i] && idx[i] > 0 && idx[i] < dynamic_end;
+  }
   CAIRN_INLINE void scatter1(double* bodies, const std::int32_t* idx, const V3& v, const V3& w, int dynamic_end,
                              M write) {
+#if defined(__AVX512F__)
+    if constexpr (W == 8) {
+      __m512d c[8], r[8];
+      __builtin_memcpy(&c[0], &v.x, 64);
+      __builtin_memcpy(&c[1], &v.y, 64);
+      __builtin_memcpy(&c[2], &v.z, 64);
+      __builtin_memcpy(&c[3], &w.x, 64);
+      __builtin_memcpy(&c[4], &w.y, 64);
+      __builtin_memcpy(&c[5], &w.z, 64);
+      c[6] = c[7] = _mm512_setzero_pd();  // the spare pair
+      transpose8(c, r);  // r[i]: body i's line
+      for (int i = 0; i < 8; ++i)
+        if (writes(idx, i, dynamic_end, write)) _mm512_storeu_pd(bodies + 8 * static_cast<long>(idx[i]), r[i]);
+      return;
+    }
+#endif
+#if defined(__AVX2__)
+    if constexpr (W == 4) {
+      __m256d c[8], lo[4], hi[4];
+      __builtin_memcpy(&c[0], &v.x, 32);
+      __builtin_memcpy(&c[1], &v.y, 32);
+      __builtin_memcpy(&c[2], &v.z, 32);
+      __builtin_memcpy(&c[3], &w.x, 32);
+      __builtin_memcpy(&c[4], &w.y, 32);
+      __builtin_memcpy(&c[5], &w.z, 32);
+      c[6] = c[7] = _mm256_setzero_pd();
+      transpose4(c, lo);      // vx vy vz wx of each body
+      transpose4(c + 4, hi);  // wy wz and the spare pair
+      for (int i = 0; i < 4; ++i) {
+        if (!writes(idx, i, dynamic_end, write)) continue;
+        double* p = bodies + 8 * static_cast<long>(idx[i]);
+        _mm256_storeu_pd(p, lo[i]);
+        _mm256_storeu_pd(p + 4, hi[i]);
+      }
+      return;
+    }
+#endif
     for (int i = 0; i < W; ++i) {
-      if (!write[i] || idx[i] <= 0 || idx[i] >= dynamic_end) continue;
+      if (!writes(idx, i, dynamic_end, write)) continue;
       double* p = bodies + 8 * static_cast<long>(idx[i]);
       p[0] = v.x[i];
       p[1] = v.y[i];

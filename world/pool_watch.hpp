@@ -42,9 +42,17 @@
 // took kSoloBetter of the pool's kSample steps, no step alone after them
 // can make the steps alone the faster (the same verdict the whole probe
 // would give, a step or two sooner). Steps are compared only
-// when they did about the same work (rows within kSameWork of each other),
-// the pool's only when it was handed a loop, and never the first step on
-// a pool back from sitting out (its workers wake from sleep).
+// when they did about the same work (rows within kSameWork of each other)
+// at a steady pace (the pool's samples within kSteady of each other, and
+// the samples alone likewise), the pool's only when it was handed a loop,
+// and never the first step on a pool back from sitting out (its workers
+// wake from sleep). The pace matters where the rows do not show the work:
+// pile-1000's boxes fall through their first 18 steps with no contact at
+// all, each step 0.16 to 1.28 ms on two threads or one as its tree and
+// pairs grow, and a probe there found the pool paying by 47% and set the
+// next probe 188 pool steps later, past the 150 awake steps in which the
+// pool ran 5 to 10% slower than one thread (docs/performance.md, "Now:
+// bodies written back as whole lines").
 #pragma once
 
 #include "cairn/stats.hpp"
@@ -87,6 +95,7 @@ class PoolWatch {
   static constexpr int kNoGainMost = 256;
   static constexpr double kSoloBetter = 0.97;
   static constexpr double kSameWork = 1.1;
+  static constexpr double kSteady = 1.5;
   static constexpr double kProbeShare = 0.01;
 
   // Before a step: whether it runs on the pool (false: on the calling
@@ -178,29 +187,39 @@ class PoolWatch {
 
   // The pool's latest kSample steps and the steps alone sampled so far (up
   // to kSample): the seconds of each summed, and whether all of them did
-  // about the same work.
+  // about the same work, the pool's and the steps alone each at a steady
+  // pace.
   struct Taken {
     double pool = 0, solo = 0;
     bool comparable = false;
   };
+  // The samples' seconds summed; their work and seconds widen the ranges.
+  struct Range {
+    int least_work, most_work;
+    double least_seconds, most_seconds;
+  };
+  static double sum(const std::array<Sample, kSample>& ring, int n, Range& r) {
+    double total = 0;
+    for (int k = 0; k < n; ++k) {
+      const Sample& x = ring[static_cast<size_t>(k)];
+      r.least_work = std::min(r.least_work, x.work);
+      r.most_work = std::max(r.most_work, x.work);
+      r.least_seconds = std::min(r.least_seconds, x.seconds);
+      r.most_seconds = std::max(r.most_seconds, x.seconds);
+      total += x.seconds;
+    }
+    return total;
+  }
+  static Range rangeOf(const Sample& x) { return {x.work, x.work, x.seconds, x.seconds}; }
+  static bool steady(const Range& r) { return r.most_seconds <= kSteady * r.least_seconds; }
   Taken taken() const {
     Taken t;
     if (pool_count_ < kSample || solo_count_ == 0) return t;
-    const int n = std::min(solo_count_, kSample);
-    int least = pool_[0].work, most = pool_[0].work;
-    for (int k = 0; k < kSample; ++k) {
-      const Sample& p = pool_[static_cast<size_t>(k)];
-      least = std::min(least, p.work);
-      most = std::max(most, p.work);
-      t.pool += p.seconds;
-    }
-    for (int k = 0; k < n; ++k) {
-      const Sample& s = solo_[static_cast<size_t>(k)];
-      least = std::min(least, s.work);
-      most = std::max(most, s.work);
-      t.solo += s.seconds;
-    }
-    t.comparable = double(most) <= kSameWork * double(least);
+    Range pool = rangeOf(pool_[0]), solo = rangeOf(solo_[0]);
+    t.pool = sum(pool_, kSample, pool);
+    t.solo = sum(solo_, std::min(solo_count_, kSample), solo);
+    const int least = std::min(pool.least_work, solo.least_work), most = std::max(pool.most_work, solo.most_work);
+    t.comparable = double(most) <= kSameWork * double(least) && steady(pool) && steady(solo);
     return t;
   }
 

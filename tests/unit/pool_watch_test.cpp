@@ -67,22 +67,24 @@ TEST(PoolWatch, ANewPoolStartsTheLengthsAgain) {
   EXPECT_EQ(runsAlone(watch, 1 + 16 + 1, [](int) { return PoolWatch::kPreemptedPerStep; }), std::vector<int>{16});
 }
 
-// A machine where a step takes `pool` seconds on the pool and `alone`
-// seconds alone, every step the same work and handing the pool a loop.
-// Returns the runs alone as (first step, length, reason), step counting
-// from 0.
+// A machine where the k-th step on the pool takes `pool(k)` seconds and a
+// step alone `alone` seconds, every step the same work and handing the
+// pool a loop. Returns the runs alone as (first step, length, reason),
+// step counting from 0.
 struct RunAlone {
   int first, length;
   AloneReason why;
   bool operator==(const RunAlone&) const = default;
 };
-std::vector<RunAlone> timedRuns(PoolWatch& watch, int steps, double pool, double alone, int work = 100,
-                                bool handed = true, int other_work_from = -1) {
+template <class PoolTime>
+std::vector<RunAlone> timedRunsBy(PoolWatch& watch, int steps, PoolTime pool, double alone, int work = 100,
+                                  bool handed = true, int other_work_from = -1) {
   std::vector<RunAlone> runs;
+  int on_pool = 0;
   for (int s = 0; s < steps; ++s) {
     const int w = other_work_from >= 0 && s >= other_work_from ? 2 * work : work;
     if (watch.startStep()) {
-      watch.endPoolStep(0, handed, pool, w);
+      watch.endPoolStep(0, handed, pool(on_pool++), w);
       continue;
     }
     const AloneReason why = watch.aside();
@@ -92,6 +94,11 @@ std::vector<RunAlone> timedRuns(PoolWatch& watch, int steps, double pool, double
     watch.endSoloStep(alone, w);
   }
   return runs;
+}
+// The same with every step on the pool `pool` seconds.
+std::vector<RunAlone> timedRuns(PoolWatch& watch, int steps, double pool, double alone, int work = 100,
+                                bool handed = true, int other_work_from = -1) {
+  return timedRunsBy(watch, steps, [pool](int) { return pool; }, alone, work, handed, other_work_from);
 }
 
 // Steps alone 20% faster than on the pool: the first probe comes after
@@ -169,6 +176,37 @@ TEST(PoolWatch, AProbeWhoseVerdictIsOpenTakesAllItsSteps) {
   PoolWatch watch;
   const std::vector<RunAlone> runs = timedRuns(watch, kSteps, 1.0 / 1.2, 1.0);
   EXPECT_EQ(runs, probesOfAPoolThatPays(kSteps, 5, fourFoldGap));
+}
+
+// Steps on the pool at an unsteady pace (0.3 and 0.8 seconds in turn,
+// beyond kSteady of each other, as while pile-1000's boxes fall and its
+// tree and pairs grow) give no verdict. A pool far faster than one thread
+// is then not set 300 pool steps apart (as at a steady 0.5 above): its
+// probes come at the four-fold gaps (each 4 steps: the third sample alone
+// seals it, 3.0 against kSoloBetter of the pool's 2.2). And steps alone
+// faster than such a pool (0.5 against 0.3 and 0.8, a mean of 0.55) do
+// not set it aside.
+TEST(PoolWatch, StepsAtAnUnsteadyPaceGiveNoVerdict) {
+  const auto unsteady = [](int k) { return k % 2 == 0 ? 0.3 : 0.8; };
+  PoolWatch watch;
+  EXPECT_EQ(timedRunsBy(watch, 3000, unsteady, 1.0), probesOfAPoolThatPays(3000, 4, fourFoldGap));
+  watch.reset();
+  EXPECT_EQ(timedRunsBy(watch, 3000, unsteady, 0.5), probesOfAPoolThatPays(3000, 5, fourFoldGap));
+}
+
+// Unsteady steps alone likewise: the pool at a steady 1.2, alone 0.5 and
+// 1.0 in turn (a mean of 0.75, far faster) keeps the pool.
+TEST(PoolWatch, StepsAloneAtAnUnsteadyPaceGiveNoVerdict) {
+  PoolWatch watch;
+  int alone = 0;
+  for (int s = 0; s < 600; ++s) {
+    if (watch.startStep()) {
+      watch.endPoolStep(0, true, 1.2, 100);
+      continue;
+    }
+    EXPECT_EQ(watch.aside(), AloneReason::Probe) << "step " << s;
+    watch.endSoloStep(alone++ % 2 == 0 ? 0.5 : 1.0, 100);
+  }
 }
 
 // Alone within 3% of the pool (kSoloBetter): the pool stays.

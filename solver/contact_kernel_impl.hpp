@@ -207,6 +207,21 @@ struct Kernel {
     out[3] = _mm256_permute2f128_pd(a1, a3, 0x31);
   }
 #endif
+  // The six velocity components of W bodies between (v, w) and six
+  // registers of W doubles (R: the instruction set's vector of W doubles;
+  // a V3 is three of them, unpadded).
+  template <class R>
+  static inline __attribute__((always_inline)) void toVelocities(const R* c, V3& v, V3& w) {
+    static_assert(sizeof(V3) == 3 * sizeof(R));
+    __builtin_memcpy(&v, c, sizeof v);
+    __builtin_memcpy(&w, c + 3, sizeof w);
+  }
+  template <class R>
+  static inline __attribute__((always_inline)) void fromVelocities(const V3& v, const V3& w, R* c) {
+    static_assert(sizeof(V3) == 3 * sizeof(R));
+    __builtin_memcpy(c, &v, sizeof v);
+    __builtin_memcpy(c + 3, &w, sizeof w);
+  }
 
   CAIRN_INLINE void gather1(const double* bodies, const std::int32_t* idx, V3& v, V3& w) {
 #if defined(__AVX512F__)
@@ -214,12 +229,7 @@ struct Kernel {
       __m512d r[8], c[8];
       for (int i = 0; i < 8; ++i) r[i] = _mm512_loadu_pd(bodies + 8 * static_cast<long>(idx[i]));
       transpose8(r, c);  // c[k]: component k of the eight bodies
-      __builtin_memcpy(&v.x, &c[0], 64);
-      __builtin_memcpy(&v.y, &c[1], 64);
-      __builtin_memcpy(&v.z, &c[2], 64);
-      __builtin_memcpy(&w.x, &c[3], 64);
-      __builtin_memcpy(&w.y, &c[4], 64);
-      __builtin_memcpy(&w.z, &c[5], 64);
+      toVelocities(c, v, w);
       return;
     }
 #endif
@@ -233,12 +243,7 @@ struct Kernel {
       }
       transpose4(lo, c);
       transpose4(hi, c + 4);
-      __builtin_memcpy(&v.x, &c[0], 32);
-      __builtin_memcpy(&v.y, &c[1], 32);
-      __builtin_memcpy(&v.z, &c[2], 32);
-      __builtin_memcpy(&w.x, &c[3], 32);
-      __builtin_memcpy(&w.y, &c[4], 32);
-      __builtin_memcpy(&w.z, &c[5], 32);
+      toVelocities(c, v, w);
       return;
     }
 #endif
@@ -270,12 +275,7 @@ struct Kernel {
 #if defined(__AVX512F__)
     if constexpr (W == 8) {
       __m512d c[8], r[8];
-      __builtin_memcpy(&c[0], &v.x, 64);
-      __builtin_memcpy(&c[1], &v.y, 64);
-      __builtin_memcpy(&c[2], &v.z, 64);
-      __builtin_memcpy(&c[3], &w.x, 64);
-      __builtin_memcpy(&c[4], &w.y, 64);
-      __builtin_memcpy(&c[5], &w.z, 64);
+      fromVelocities(v, w, c);
       c[6] = c[7] = _mm512_setzero_pd();  // the spare pair
       transpose8(c, r);  // r[i]: body i's line
       for (int i = 0; i < 8; ++i)
@@ -286,12 +286,7 @@ struct Kernel {
 #if defined(__AVX2__)
     if constexpr (W == 4) {
       __m256d c[8], lo[4], hi[4];
-      __builtin_memcpy(&c[0], &v.x, 32);
-      __builtin_memcpy(&c[1], &v.y, 32);
-      __builtin_memcpy(&c[2], &v.z, 32);
-      __builtin_memcpy(&c[3], &w.x, 32);
-      __builtin_memcpy(&c[4], &w.y, 32);
-      __builtin_memcpy(&c[5], &w.z, 32);
+      fromVelocities(v, w, c);
       c[6] = c[7] = _mm256_setzero_pd();
       transpose4(c, lo);      // vx vy vz wx of each body
       transpose4(c + 4, hi);  // wy wz and the spare pair

@@ -48,11 +48,12 @@
 // and never the first step on a pool back from sitting out (its workers
 // wake from sleep). The pace matters where the rows do not show the work:
 // pile-1000's boxes fall through their first 18 steps with no contact at
-// all, each step 0.16 to 1.28 ms on two threads or one as its tree and
-// pairs grow, and a probe there found the pool paying by 47% and set the
-// next probe 188 pool steps later, past the 150 awake steps in which the
-// pool ran 5 to 10% slower than one thread (docs/performance.md, "Now:
-// bodies written back as whole lines").
+// all, each step 0.16 to 1.28 ms on two threads as its tree and pairs
+// grow; a probe there found its steps alone 1.47 times as long as the
+// pool's and set the next probe 190 pool steps later, past the 150 awake
+// steps, where what the pool gains is the machine's (9% lost in one
+// spell, 14% gained in another: docs/performance.md, "Now: bodies
+// written back as whole lines, ...").
 #pragma once
 
 #include "cairn/stats.hpp"

@@ -50,7 +50,7 @@
 // pile-1000's boxes fall through their first 18 steps with no contact at
 // all, each step 0.16 to 1.28 ms on two threads as its tree and pairs
 // grow; a probe there found its steps alone 1.47 times as long as the
-// pool's and set the next probe 190 pool steps later, past the 150 awake
+// pool's and set the next probe 190 pool steps later, past the 162 awake
 // steps, where what the pool gains is the machine's (9% lost in one
 // spell, 14% gained in another: docs/performance.md, "Now: bodies
 // written back as whole lines, ...").

@@ -67,20 +67,20 @@ TEST(PoolWatch, ANewPoolStartsTheLengthsAgain) {
   EXPECT_EQ(runsAlone(watch, 1 + 16 + 1, [](int) { return PoolWatch::kPreemptedPerStep; }), std::vector<int>{16});
 }
 
-// A machine where the k-th step on the pool takes `pool(k)` seconds and a
-// step alone `alone` seconds, every step the same work and handing the
-// pool a loop. Returns the runs alone as (first step, length, reason),
+// A machine where the k-th step on the pool takes `pool(k)` seconds and
+// the k-th step alone `alone(k)` seconds, every step the same work and
+// handing the pool a loop. Returns the runs alone as (first step, length, reason),
 // step counting from 0.
 struct RunAlone {
   int first, length;
   AloneReason why;
   bool operator==(const RunAlone&) const = default;
 };
-template <class PoolTime>
-std::vector<RunAlone> timedRunsBy(PoolWatch& watch, int steps, PoolTime pool, double alone, int work = 100,
+template <class PoolTime, class AloneTime>
+std::vector<RunAlone> timedRunsBy(PoolWatch& watch, int steps, PoolTime pool, AloneTime alone, int work = 100,
                                   bool handed = true, int other_work_from = -1) {
   std::vector<RunAlone> runs;
-  int on_pool = 0;
+  int on_pool = 0, alone_count = 0;
   for (int s = 0; s < steps; ++s) {
     const int w = other_work_from >= 0 && s >= other_work_from ? 2 * work : work;
     if (watch.startStep()) {
@@ -91,14 +91,16 @@ std::vector<RunAlone> timedRunsBy(PoolWatch& watch, int steps, PoolTime pool, do
     if (runs.empty() || runs.back().first + runs.back().length != s || runs.back().why != why)
       runs.push_back({s, 0, why});
     ++runs.back().length;
-    watch.endSoloStep(alone, w);
+    watch.endSoloStep(alone(alone_count++), w);
   }
   return runs;
 }
-// The same with every step on the pool `pool` seconds.
+// The same with every step on the pool `pool` seconds, every step alone
+// `alone`.
 std::vector<RunAlone> timedRuns(PoolWatch& watch, int steps, double pool, double alone, int work = 100,
                                 bool handed = true, int other_work_from = -1) {
-  return timedRunsBy(watch, steps, [pool](int) { return pool; }, alone, work, handed, other_work_from);
+  return timedRunsBy(
+      watch, steps, [pool](int) { return pool; }, [alone](int) { return alone; }, work, handed, other_work_from);
 }
 
 // Steps alone 20% faster than on the pool: the first probe comes after
@@ -189,24 +191,17 @@ TEST(PoolWatch, AProbeWhoseVerdictIsOpenTakesAllItsSteps) {
 TEST(PoolWatch, StepsAtAnUnsteadyPaceGiveNoVerdict) {
   const auto unsteady = [](int k) { return k % 2 == 0 ? 0.3 : 0.8; };
   PoolWatch watch;
-  EXPECT_EQ(timedRunsBy(watch, 3000, unsteady, 1.0), probesOfAPoolThatPays(3000, 4, fourFoldGap));
+  EXPECT_EQ(timedRunsBy(watch, 3000, unsteady, [](int) { return 1.0; }), probesOfAPoolThatPays(3000, 4, fourFoldGap));
   watch.reset();
-  EXPECT_EQ(timedRunsBy(watch, 3000, unsteady, 0.5), probesOfAPoolThatPays(3000, 5, fourFoldGap));
+  EXPECT_EQ(timedRunsBy(watch, 3000, unsteady, [](int) { return 0.5; }), probesOfAPoolThatPays(3000, 5, fourFoldGap));
 }
 
 // Unsteady steps alone likewise: the pool at a steady 1.2, alone 0.5 and
 // 1.0 in turn (a mean of 0.75, far faster) keeps the pool.
 TEST(PoolWatch, StepsAloneAtAnUnsteadyPaceGiveNoVerdict) {
   PoolWatch watch;
-  int alone = 0;
-  for (int s = 0; s < 600; ++s) {
-    if (watch.startStep()) {
-      watch.endPoolStep(0, true, 1.2, 100);
-      continue;
-    }
-    EXPECT_EQ(watch.aside(), AloneReason::Probe) << "step " << s;
-    watch.endSoloStep(alone++ % 2 == 0 ? 0.5 : 1.0, 100);
-  }
+  const auto unsteady = [](int k) { return k % 2 == 0 ? 0.5 : 1.0; };
+  for (const RunAlone& r : timedRunsBy(watch, 600, [](int) { return 1.2; }, unsteady)) EXPECT_EQ(r.why, AloneReason::Probe);
 }
 
 // Alone within 3% of the pool (kSoloBetter): the pool stays.
